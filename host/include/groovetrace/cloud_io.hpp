@@ -1,0 +1,46 @@
+#pragma once
+// Reading scans (PCD, PLY) and writing the annotated cloud.
+
+#include <groovetrace/cloud.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+
+/// Options for read_cloud.
+struct ReadOptions {
+  double units_scale = 1.0;  ///< file coordinates * units_scale = metres (mm files: 0.001)
+  std::size_t min_valid_points = 100;  ///< fewer finite points: InputError
+};
+
+/// Reads a PCD (ascii, binary, binary_compressed) or PLY file into a Cloud in metres.
+/// Organized PCDs (HEIGHT > 1) keep their layout; WIDTH N HEIGHT 1 is unorganized. NaN
+/// points stay in place. The PCD VIEWPOINT translation becomes cloud.viewpoint (scaled).
+/// Throws InputError (one line) for: missing or unreadable file, unknown extension, a
+/// malformed or truncated file, no x/y/z fields, no points, all points NaN, fewer than
+/// min_valid_points finite points, or any infinite coordinate.
+Cloud read_cloud(const std::string& path, const ReadOptions& options = {});
+
+/// Per-point annotations written beside the input points.
+struct Annotations {
+  const Normals* normals = nullptr;                  ///< cloud frame, unit, NaN = none
+  const std::vector<float>* descriptor = nullptr;    ///< D (deg^2), NaN = none
+  const std::vector<std::uint8_t>* groove = nullptr;  ///< 1 = groove
+};
+
+/// Binary PCD with fields `x y z normal_x normal_y normal_z descriptor groove` (groove as
+/// uint8), the points of `cloud` in its order and shape (width, height, viewpoint).
+/// Returns the file's bytes; write them with write_file_atomic.
+std::string annotated_pcd_bytes(const Cloud& cloud, const Annotations& annotations);
+
+/// Writes a plain XYZ binary PCD (organized if cloud is), e.g. for generated scans.
+std::string pcd_bytes(const Cloud& cloud);
+
+/// Writes `bytes` to `path` completely or not at all: a temporary file in the same
+/// directory, flushed, then renamed over `path`. Throws InputError on failure.
+void write_file_atomic(const std::string& path, const std::string& bytes);
+
+}  // namespace groovetrace

@@ -1,0 +1,40 @@
+#pragma once
+// From descriptor values to the groove point set: threshold, then connected components.
+
+#include <groovetrace/cloud.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace groovetrace {
+
+/// Otsu's threshold on log(D) over the finite, positive descriptor values (deg^2).
+/// log because D spans orders of magnitude between flats and creases. NaN if < 2 values.
+double otsu_threshold(const std::vector<float>& descriptor);
+
+/// Connected parts of the points with mask[i] != 0: two points are linked when they are
+/// within `link_distance` (m) in 3-D. Returns a label per point (-1 outside the mask),
+/// labels ordered by decreasing part size, and the size of each part.
+struct Components {
+  std::vector<int> label;
+  std::vector<std::size_t> sizes;
+};
+Components connected_components(const Cloud& cloud, const std::vector<std::uint8_t>& mask,
+                                 float link_distance);
+
+/// Result of detection: groove mask (1 = groove) and what was decided on the way.
+struct Detection {
+  std::vector<std::uint8_t> groove;  ///< 1 for points of the kept groove parts
+  double threshold = 0.0;            ///< threshold used (deg^2)
+  std::size_t above_threshold = 0;   ///< points with D > threshold before speck removal
+  std::size_t components = 0;        ///< parts kept
+  std::vector<std::size_t> component_sizes;  ///< sizes of the kept parts, largest first
+  std::vector<int> component_label;  ///< per point: kept part index, -1 otherwise
+};
+
+/// Thresholds `descriptor` and keeps the connected parts with at least `min_component`
+/// points. `threshold` is used unless it is NaN, in which case Otsu's threshold is used.
+Detection detect_groove(const Cloud& cloud, const std::vector<float>& descriptor,
+                        double threshold, int min_component, float link_distance);
+
+}  // namespace groovetrace

@@ -1,0 +1,58 @@
+#pragma once
+// The per-point work (smoothing, normals, groove descriptor) behind one interface, so the
+// OpenCL kernels and the CPU reference are interchangeable and checked against each other.
+
+#include <groovetrace/cloud.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+
+/// Moving-least-squares smoothing settings.
+struct SmoothParams {
+  float radius = 0.003f;  ///< search radius (m); weights are Gaussian with h = radius
+  int order = 2;          ///< 1 = project onto the weighted plane, 2 = onto a fitted quadric
+  int min_neighbors = 5;  ///< fewer neighbours: the point is kept unchanged
+};
+
+/// Per-point work of the pipeline. Every method keeps input order and size; invalid (NaN)
+/// points stay invalid. Neighbours are the valid points within `radius` (m) in 3-D.
+class FeatureBackend {
+ public:
+  virtual ~FeatureBackend() = default;
+  /// "cpu" or "opencl".
+  virtual std::string name() const = 0;
+  /// Human-readable device, e.g. "OpenMP, 2 threads" or the OpenCL device name.
+  virtual std::string device() const = 0;
+
+  /// MLS-smoothed copy of `cloud` (same frame, metres).
+  virtual Cloud smooth(const Cloud& cloud, const SmoothParams& params) = 0;
+
+  /// PCA normals over the neighbours within `radius` (m), each flipped to face
+  /// `cloud.viewpoint`. A point with fewer than `min_neighbors` neighbours (itself
+  /// included) gets a NaN normal.
+  virtual Normals normals(const Cloud& cloud, float radius, int min_neighbors) = 0;
+
+  /// The paper's surface-variation descriptor D (deg^2) per point, eqs. 2-6:
+  /// sigma_l = population variance of the angles between n_i and each neighbour's normal
+  /// (neighbours j != i), sigma_g = population variance of the angles between each normal in
+  /// the neighbourhood (i included) and `u_b`; D = sqrt(sigma_l^2 + sigma_g^2). Points
+  /// without a normal, or with no neighbour that has one, get NaN.
+  virtual std::vector<float> descriptor(const Cloud& cloud, const Normals& normals, float radius,
+                                        const Eigen::Vector3f& u_b) = 0;
+};
+
+/// The benchmark normal u_b = normalize(sum of all valid normals) (paper eq. 4).
+/// Returns NaN if the normals sum to zero.
+Eigen::Vector3f benchmark_normal(const Normals& normals);
+
+/// Creates a backend by name: "cpu", "opencl" or "auto" (opencl when available, else cpu).
+/// Throws UsageError for an unknown name.
+std::unique_ptr<FeatureBackend> make_backend(const std::string& name);
+
+/// The CPU reference backend (OpenMP + Eigen).
+std::unique_ptr<FeatureBackend> make_cpu_backend();
+
+}  // namespace groovetrace
