@@ -7,6 +7,7 @@
 #include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,9 +27,13 @@ struct RunResult {
   std::string backend, device;
 };
 
+/// Called after each stage with its name and duration (ms), e.g. to print progress.
+using StageCallback = std::function<void(const std::string& stage, double ms)>;
+
 /// Runs smoothing, normals, descriptor, detection and trajectory on `cloud` (metres).
 /// Throws NoGrooveError when no groove is found, UsageError for bad parameters.
-RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend& backend);
+RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend& backend,
+                       const StageCallback& on_stage = {});
 
 /// Checks parameter ranges; throws UsageError naming the offending parameter.
 void validate(const Params& params);

@@ -1,0 +1,127 @@
+// `groovetrace run SCAN -o OUTDIR`: the whole pipeline on one scan.
+#include <groovetrace/cloud_io.hpp>
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
+#include <groovetrace/pipeline.hpp>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "commands.hpp"
+
+namespace groovetrace::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunOptions {
+  std::string scan, out_dir, config;
+  bool quiet = false;
+  std::map<std::string, std::string> flags;  // param key -> text, only for flags given
+};
+
+std::string dashed(std::string key) {
+  for (char& c : key) {
+    if (c == '_') c = '-';
+  }
+  return key;
+}
+
+// Fails before any work if OUTDIR cannot be created or written, so a long run is not lost.
+void check_output_dir(const std::string& dir) {
+  fs::path p = fs::absolute(dir);
+  std::error_code ec;
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) {
+    throw InputError("output path " + dir + " exists and is not a directory");
+  }
+  while (!fs::exists(p, ec)) p = p.parent_path();
+  if (!fs::is_directory(p, ec)) {
+    throw InputError("cannot create output directory " + dir + ": " + p.string() +
+                     " is not a directory");
+  }
+  if (::access(p.c_str(), W_OK) != 0) {
+    throw InputError("output directory " + dir + " is not writable");
+  }
+}
+
+int run(const RunOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Params params;
+  if (!opt.config.empty()) apply_config_file(params, opt.config);
+  for (const auto& [key, text] : opt.flags) {
+    try {
+      set_param(params, key, text);
+    } catch (const UsageError& e) {
+      throw UsageError("--" + dashed(key) + ": " + std::string(e.what()).substr(key.size() + 2));
+    }
+  }
+  validate(params);
+  check_output_dir(opt.out_dir);
+  auto say = [&](const char* fmt, auto... args) {
+    if (!opt.quiet) {
+      std::printf(fmt, args...);
+      std::fflush(stdout);
+    }
+  };
+
+  ReadOptions ro;
+  ro.units_scale = params.units_scale;
+  const Cloud cloud = read_cloud(opt.scan, ro);
+  const double load_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  say("groovetrace: read %s: %zu points (%ux%u), %zu valid [%.0f ms]\n", opt.scan.c_str(),
+      cloud.size(), cloud.width, cloud.height, cloud.count_valid(), load_ms);
+
+  std::unique_ptr<FeatureBackend> backend = make_backend(params.backend);
+  say("groovetrace: backend %s (%s)\n", backend->name().c_str(), backend->device().c_str());
+  RunResult result = run_pipeline(cloud, params, *backend, [&](const std::string& stage, double ms) {
+    say("groovetrace: %-10s %8.0f ms\n", stage.c_str(), ms);
+  });
+  result.timings_ms.insert(result.timings_ms.begin(), {"load", load_ms});
+  for (const auto& w : result.warnings) std::fprintf(stderr, "groovetrace: warning: %s\n", w.c_str());
+
+  const auto t_write = std::chrono::steady_clock::now();
+  const double before_write_ms =
+      std::chrono::duration<double, std::milli>(t_write - t0).count();
+  auto files = render_outputs(cloud, result, params, opt.scan, before_write_ms);
+  write_outputs(opt.out_dir, files);
+  const double write_ms = std::chrono::duration<double, std::milli>(
+                              std::chrono::steady_clock::now() - t_write)
+                              .count();
+  say("groovetrace: write      %8.0f ms\n", write_ms);
+  say("groovetrace: %zu groove points, %zu waypoints (%s frame), %.1f mm long\n",
+      static_cast<std::size_t>(std::count(result.detection.groove.begin(),
+                                          result.detection.groove.end(), 1)),
+      result.trajectory.waypoints.size(), result.trajectory.frame.c_str(),
+      result.trajectory.length * 1000);
+  say("groovetrace: outputs in %s:", opt.out_dir.c_str());
+  for (const auto& f : files) say(" %s", f.first.c_str());
+  say("\n");
+  return 0;
+}
+
+}  // namespace
+
+Command add_run_command(CLI::App& app) {
+  auto opt = std::make_shared<RunOptions>();
+  CLI::App* sub = app.add_subcommand("run", "detect the groove in SCAN and write the outputs");
+  sub->add_option("scan", opt->scan, "input scan (.pcd or .ply)")->required();
+  sub->add_option("-o,--output", opt->out_dir, "output directory (created if missing)")
+      ->required();
+  sub->add_option("--config", opt->config, "YAML or JSON file of parameters (flags win)");
+  sub->add_flag("-q,--quiet", opt->quiet, "print nothing but warnings and errors");
+  for (const auto& spec : param_specs()) {
+    const std::string key = spec.key;
+    sub->add_option_function<std::string>(
+        "--" + dashed(key), [opt, key](const std::string& v) { opt->flags[key] = v; },
+        spec.help);
+  }
+  return {sub, [opt] { return run(*opt); }};
+}
+
+}  // namespace groovetrace::cli

@@ -1,0 +1,263 @@
+#pragma once
+// Synthetic RealSense D415 scans of V-groove workpieces, with ground truth (issue 3).
+//
+// No public labelled scans of V-grooves exist, so accuracy claims rest on these: an analytic
+// workpiece on a welding table is ray cast through a pinhole camera, then a D415 sensor model
+// (DESIGN.md, "RealSense D415 facts") turns the ideal depth into what the camera returns.
+//
+// Frames. The workpiece frame W: the table is the plane z = 0, z points up out of the table,
+// the seam runs along +x through the origin's vertical (x, y in the table plane). The camera
+// frame C is the RealSense depth frame: x right, y down, z forward (metres), origin at the
+// left imager's centre; the right imager sits at (+baseline, 0, 0). `T_workpiece_camera`
+// maps camera coordinates to workpiece coordinates: p_workpiece = T_workpiece_camera * p_camera.
+
+#include <groovetrace/cloud.hpp>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+
+/// The workpieces. The paper's four are straight, curve, box and cylinder.
+enum class Shape {
+  kStraight,  ///< butt V-groove straight across a 300 x 200 mm plate lying on the table
+  kCurve,     ///< V-groove along an S curve (two tangent arcs) in the same plate
+  kBox,       ///< straight groove across the top of a raised 160 x 100 x 60 mm block
+  kCylinder,  ///< circumferential groove around a 100 mm pipe lying on the table
+  kPipeLong,  ///< longitudinal groove along the top of the same pipe
+  kLShape,    ///< a seam with a 90 degree corner in the plate
+  kMulti,     ///< two parallel straight grooves, 80 mm apart, in the plate
+};
+
+/// Lower-case CLI name of a shape ("straight", "curve", "box", "cylinder", "pipe-long",
+/// "lshape", "multi").
+const char* shape_name(Shape shape);
+/// Inverse of shape_name; throws UsageError listing the known names.
+Shape parse_shape(const std::string& name);
+/// All shape names, in enum order.
+std::vector<std::string> shape_names();
+
+/// Which sensor effects the D415 model applies (all only when SynthParams::noise is on).
+struct SensorEffects {
+  bool depth_noise = true;      ///< per-pixel disparity noise (DESIGN.md depth RMS formula)
+  bool undulation = true;       ///< spatially correlated disparity error over 5-20 mm
+  bool blur = true;             ///< stereo matching window averages disparity across creases
+  bool flying_pixels = true;    ///< depths between foreground and background at jumps
+  bool grazing_dropout = true;  ///< no return at high incidence angles
+  bool stereo_shadow = true;    ///< no return where the right imager cannot see the point
+  bool left_band = true;        ///< no return in the left band the right imager does not see
+  bool random_dropout = true;   ///< isolated missing pixels
+  bool min_z = true;            ///< no return closer than SensorModel::min_z
+  bool quantize = true;         ///< depth rounded to SynthParams::depth_unit
+
+  static SensorEffects all() { return {}; }
+  static SensorEffects none();
+  bool any() const;
+};
+
+/// Parses a comma-separated effect list: "all", "none", or names from
+/// {depth,undulation,blur,flying,grazing,shadow,band,dropout,minz,quantize}; the named effects
+/// are on, the others off. Throws UsageError for an unknown name.
+SensorEffects parse_effects(const std::string& list);
+/// The comma-separated names of the effects that are on ("none" if no effect is on).
+std::string effects_string(const SensorEffects& effects);
+
+/// D415 constants of the sensor model. Defaults follow DESIGN.md; change them to model
+/// another stereo camera.
+struct SensorModel {
+  double hfov_deg = 65.0;  ///< horizontal field of view at every resolution (deg)
+  double vfov_deg = 40.0;  ///< vertical field of view of the native 16:9 frame (deg)
+  double baseline = 0.055;             ///< left-right imager distance (m)
+  double subpixel = 0.08;              ///< per-pixel disparity noise RMS (px)
+  double undulation_disparity = 0.10;  ///< correlated disparity error std (px); 0.45 mm at 0.5 m
+  double undulation_min_wavelength = 0.010;  ///< undulation wavelengths (m, at the look-at
+  double undulation_max_wavelength = 0.040;  ///< distance): half-waves of 5-20 mm
+  int blur_radius_1280 = 2;     ///< matching window half-width (px) at 1280 columns, scaled
+  double jump_disparity = 1.0;  ///< neighbours whose disparities differ more are a depth jump
+  double flying_probability = 0.35;  ///< chance that a pixel at a jump becomes a flying pixel
+  double grazing_start_deg = 75.0;   ///< incidence where returns start to drop out
+  double grazing_full_deg = 82.0;    ///< incidence beyond which nothing returns
+  double dropout_probability = 0.005;  ///< independent missing pixels
+  double min_z = 0.28;  ///< closest depth (m); a D415 with disparity shift for close range
+};
+
+/// Everything that determines a synthetic scan. Lengths in metres, angles in degrees.
+struct SynthParams {
+  Shape shape = Shape::kStraight;
+  double groove_width = 0.010;     ///< top width of the V between its two top edges (m)
+  double groove_angle_deg = 60.0;  ///< included angle between the two walls (deg)
+  double groove_depth = 0.0;  ///< depth of the V (m); > 0 overrides groove_angle_deg
+  double root_gap = 0.0005;   ///< gap between the two parts at the root (m)
+  double distance = 0.40;     ///< camera origin to the look-at point on the seam (m)
+  double tilt_deg = 0.0;      ///< camera pitch about its x axis, across the seam (deg)
+  double roll_deg = 0.0;      ///< camera roll about its optical axis (deg)
+  int width = 1280;           ///< image columns (D415 modes: 1280x720, 848x480, 640x480)
+  int height = 720;           ///< image rows
+  std::uint64_t seed = 1;     ///< every random choice comes from this
+  bool noise = true;          ///< false: ideal geometry, no sensor effect at all
+  SensorEffects effects;      ///< which effects apply when noise is on
+  double depth_unit = 0.001;  ///< depth quantisation step (m): 0.001 default, 0.0001 fine
+  SensorModel sensor;
+};
+
+/// Checks parameter ranges; throws UsageError naming the offending parameter.
+void validate(const SynthParams& params);
+
+/// The groove's cross-section as built (metres, degrees). The V's walls run from the two top
+/// edges (top_width apart) down to the root at `depth`; below the root a vertical gap of
+/// width root_gap runs through the rest of the part (`thickness`).
+struct GrooveGeometry {
+  double top_width = 0.0;
+  double depth = 0.0;
+  double included_angle_deg = 0.0;
+  double root_gap = 0.0;
+  double thickness = 0.0;  ///< plate, block top or pipe wall thickness (m)
+};
+/// The geometry SynthParams describe: depth = (top_width - root_gap) / (2 tan(angle / 2))
+/// unless groove_depth is given; thickness = max(10 mm, depth + 1.5 mm).
+GrooveGeometry groove_geometry(const SynthParams& params);
+
+/// Pinhole camera (no distortion, as RealSense depth streams). Pixel (u, v) = (column, row)
+/// looks along (u - cx) / fx, (v - cy) / fy, 1 in the camera frame.
+struct CameraModel {
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pixels
+  /// Ray through pixel (u, v), camera frame, z = 1 (so a point at depth Z is Z * ray).
+  Eigen::Vector3d ray(double u, double v) const { return {(u - cx) / fx, (v - cy) / fy, 1.0}; }
+};
+/// D415 intrinsics at a resolution: fx = 0.5 width / tan(HFOV / 2); fy from the VFOV of the
+/// native 16:9 frame, fy = 0.5 (width * 9 / 16) / tan(VFOV / 2) (so 4:3 modes see more rows);
+/// cx = (width - 1) / 2, cy = (height - 1) / 2. 1280x720: fx 1004.6, fy 989.1.
+CameraModel d415_camera(int width, int height, const SensorModel& sensor = {});
+
+/// One seam's true root line. Vertices are about 1 mm apart; a closed seam repeats its first
+/// vertex at the end. All vectors in the frame of the container (camera frame in SynthTruth).
+struct Seam {
+  std::vector<Eigen::Vector3d> root;    ///< root line (m): centre of the gap at the V's bottom
+  std::vector<Eigen::Vector3d> normal;  ///< unit surface normal of the part there, out of the
+                                        ///< workpiece (towards the camera side)
+  std::vector<Eigen::Vector3d> bisector;  ///< unit bisector of the two walls, out of the
+                                          ///< groove; the tool z axis should be -bisector
+  std::vector<std::uint8_t> in_view;  ///< 1: inside the image where the sensor can return,
+                                      ///< facing the camera, the groove above it unhidden
+  bool closed = false;
+  double length() const;          ///< polyline length (m)
+  double length_in_view() const;  ///< length of the segments with both ends in view (m)
+};
+
+/// Ground truth of a scan, aligned with its cloud.
+struct SynthTruth {
+  SynthParams params;
+  GrooveGeometry groove;
+  CameraModel camera;
+  Eigen::Isometry3d T_workpiece_camera = Eigen::Isometry3d::Identity();
+  std::vector<std::uint8_t> label;  ///< per point, cloud order: 1 = on a groove wall (between
+                                    ///< the two top edges, root gap included), else 0
+  std::vector<std::uint8_t> valid;  ///< per point: 1 = the scan has a return (finite point)
+  std::vector<Seam> seams;          ///< camera frame
+};
+
+/// A rendered scan: organized cloud in the camera frame (metres, NaN where the sensor returns
+/// nothing, viewpoint at the origin) and its truth.
+struct SynthScan {
+  Cloud cloud;
+  SynthTruth truth;
+};
+
+/// Renders a scan. Deterministic: the same params (seed included) give the same bytes,
+/// independent of the thread count. Throws UsageError for invalid params.
+SynthScan render(const SynthParams& params);
+
+// --- Building blocks (used by render; public so that tests can check each alone) ----------
+
+/// A surface point found by ray casting, workpiece frame.
+struct RayHit {
+  bool hit = false;
+  double t = 0.0;          ///< distance along the unit ray direction (m)
+  Eigen::Vector3d point;   ///< m
+  Eigen::Vector3d normal;  ///< unit, out of the solid
+  std::uint8_t label = 0;  ///< 1 = groove wall (or the table seen through the root gap)
+  bool table = false;      ///< the hit is on the table plane
+};
+
+/// The workpiece of SynthParams (shape and groove) on the table, in the workpiece frame.
+class SynthScene {
+ public:
+  explicit SynthScene(const SynthParams& params);
+  ~SynthScene();
+  SynthScene(const SynthScene&) = delete;
+  SynthScene& operator=(const SynthScene&) = delete;
+
+  /// First surface along origin + t * direction (unit) with t < t_max, workpiece frame.
+  /// Sphere tracing on a 1-Lipschitz signed distance bound, then bisection to 1e-7 m.
+  RayHit intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                   double t_max) const;
+  /// True if a surface lies between `from` and `to` closer than `tolerance` (m) to `from`'s
+  /// side of `to` (i.e. `to` is hidden from `from`). Workpiece frame.
+  bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                double tolerance) const;
+  /// Signed distance bound of the workpiece (m): <= 0 inside, > 0 outside, 1-Lipschitz (not
+  /// the table).
+  double signed_distance(const Eigen::Vector3d& p) const;
+  /// The seams' root lines in the workpiece frame (in_view all 1).
+  std::vector<Seam> seams() const;
+  /// The point the camera looks at: the seam's centre on the top surface (m).
+  Eigen::Vector3d look_at() const;
+  const GrooveGeometry& groove() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Camera pose for the params: looking straight down at scene.look_at() from `distance`
+/// with image x along the seam (+x of the workpiece), then pitched by tilt about the camera
+/// x axis and rolled about its optical axis, both about the look-at point.
+Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene);
+
+/// What an ideal sensor sees, per pixel in row-major order.
+struct IdealFrame {
+  std::vector<double> depth;          ///< camera-frame z of the hit (m); NaN: no surface
+  std::vector<float> cos_incidence;   ///< |cos| of the angle between ray and surface normal
+  std::vector<std::uint8_t> label;    ///< groove-wall label of the hit surface
+  std::vector<std::uint8_t> shadowed; ///< 1: the right imager cannot see the hit point
+};
+
+/// Ray casts every pixel. Shadow rays only when noise and stereo_shadow are on.
+IdealFrame render_ideal(const SynthScene& scene, const CameraModel& camera,
+                        const Eigen::Isometry3d& T_workpiece_camera, const SynthParams& params);
+
+/// Applies the D415 model (the effects enabled in params) to an ideal frame and returns the
+/// organized camera-frame cloud (m, NaN = no return). With noise off the points are the exact
+/// hits.
+Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
+                      const SynthParams& params);
+
+// --- Files --------------------------------------------------------------------------------
+
+/// The three files of a synthetic scan: SCAN.pcd (binary organized XYZ), SCAN.truth.json
+/// (params, camera, pose, counts, seams) and SCAN.labels.pcd (binary PCD, same WIDTH and
+/// HEIGHT, uint8 fields `label valid`). See docs/synthetic-scans.md.
+struct SynthFiles {
+  std::string scan, truth, labels;
+};
+/// File names for a scan path, which must end in ".pcd" (UsageError otherwise).
+SynthFiles synth_files(const std::string& scan_path);
+
+/// SCAN.truth.json contents. `scan_name` and `labels_name` are recorded as written.
+std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
+                       const std::string& labels_name);
+/// SCAN.labels.pcd contents.
+std::string labels_pcd_bytes(const SynthTruth& truth);
+
+/// Writes SCAN.pcd and its truth files, each atomically. Returns their names.
+SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path);
+
+/// Reads the truth of SCAN.pcd (its .truth.json and .labels.pcd; the scan itself is not
+/// read). Throws InputError for missing or malformed files.
+SynthTruth read_synth_truth(const std::string& scan_path);
+
+}  // namespace groovetrace

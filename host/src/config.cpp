@@ -1,0 +1,291 @@
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace groovetrace {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+double parse_number(const std::string& key, const std::string& text) {
+  const std::string t = trim(text);
+  std::size_t used = 0;
+  double v = NAN;
+  try {
+    v = std::stod(t, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (t.empty() || used != t.size() || !std::isfinite(v)) {
+    throw UsageError(key + ": expected a number, got '" + text + "'");
+  }
+  return v;
+}
+
+double in_range(const std::string& key, const std::string& text, double lo, double hi,
+                const std::string& unit) {
+  const double v = parse_number(key, text);
+  if (v < lo || v > hi) {
+    std::ostringstream m;
+    m << key << ": " << text << " is out of range [" << lo << ", " << hi << "]" << unit;
+    throw UsageError(m.str());
+  }
+  return v;
+}
+
+int int_in_range(const std::string& key, const std::string& text, int lo, int hi) {
+  const double v = in_range(key, text, lo, hi, "");
+  if (v != std::floor(v)) throw UsageError(key + ": expected an integer, got '" + text + "'");
+  return static_cast<int>(v);
+}
+
+bool parse_bool(const std::string& key, const std::string& text) {
+  const std::string t = trim(text);
+  if (t == "true" || t == "1" || t == "on" || t == "yes") return true;
+  if (t == "false" || t == "0" || t == "off" || t == "no") return false;
+  throw UsageError(key + ": expected true or false, got '" + text + "'");
+}
+
+std::string one_of(const std::string& key, const std::string& text,
+                   const std::vector<std::string>& allowed) {
+  const std::string t = trim(text);
+  std::string list;
+  for (const auto& a : allowed) {
+    if (t == a) return t;
+    list += (list.empty() ? "" : ", ") + a;
+  }
+  throw UsageError(key + ": expected one of " + list + ", got '" + text + "'");
+}
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+std::string quoted(const std::string& s) { return nlohmann::json(s).dump(); }
+
+// A length parameter in metres with a plausible range, so that "--radius 3" (meant as mm)
+// is refused instead of running for an hour.
+ParamSpec length(const std::string& key, const std::string& help, double Params::*field,
+                 double lo, double hi) {
+  return {key, help + " (m)",
+          [=](Params& p, const std::string& t) { p.*field = in_range(key, t, lo, hi, " m"); },
+          [=](const Params& p) { return num(p.*field); }};
+}
+ParamSpec real(const std::string& key, const std::string& help, double Params::*field,
+               double lo, double hi, const std::string& unit) {
+  return {key, help + " (" + unit + ")",
+          [=](Params& p, const std::string& t) {
+            p.*field = in_range(key, t, lo, hi, " " + unit);
+          },
+          [=](const Params& p) { return num(p.*field); }};
+}
+ParamSpec integer(const std::string& key, const std::string& help, int Params::*field, int lo,
+                  int hi) {
+  return {key, help,
+          [=](Params& p, const std::string& t) { p.*field = int_in_range(key, t, lo, hi); },
+          [=](const Params& p) { return std::to_string(p.*field); }};
+}
+ParamSpec choice(const std::string& key, const std::string& help, std::string Params::*field,
+                 std::vector<std::string> allowed) {
+  return {key, help,
+          [=](Params& p, const std::string& t) { p.*field = one_of(key, t, allowed); },
+          [=](const Params& p) { return quoted(p.*field); }};
+}
+ParamSpec path(const std::string& key, const std::string& help, std::string Params::*field) {
+  return {key, help,
+          [=](Params& p, const std::string& t) {
+            if (trim(t).empty()) throw UsageError(key + ": expected a file path");
+            p.*field = t;
+          },
+          [=](const Params& p) { return (p.*field).empty() ? std::string("null") : quoted(p.*field); }};
+}
+
+std::vector<ParamSpec> build_specs() {
+  std::vector<ParamSpec> s;
+  s.push_back(choice("method", "detection method: paper (as published)", &Params::method,
+                     {"paper"}));
+  s.push_back(choice("backend", "feature backend: auto, cpu or opencl", &Params::backend,
+                     {"auto", "cpu", "opencl"}));
+  s.push_back({"units", "unit of the input coordinates: m or mm",
+               [](Params& p, const std::string& t) {
+                 p.units_scale = one_of("units", t, {"m", "mm"}) == "mm" ? 0.001 : 1.0;
+               },
+               [](const Params& p) { return quoted(p.units_scale == 1.0 ? "m" : "mm"); }});
+  s.push_back({"smooth", "MLS smoothing before normals: true or false",
+               [](Params& p, const std::string& t) { p.smooth = parse_bool("smooth", t); },
+               [](const Params& p) { return std::string(p.smooth ? "true" : "false"); }});
+  s.push_back(length("mls_radius", "MLS search radius", &Params::mls_radius, 1e-5, 0.1));
+  s.push_back(integer("mls_order", "MLS polynomial order: 1 plane, 2 quadric",
+                      &Params::mls_order, 1, 2));
+  s.push_back(length("radius", "neighbourhood radius r for normals and the GFH",
+                     &Params::radius, 1e-5, 0.1));
+  s.push_back(integer("min_neighbors", "fewer neighbours within r: no normal, never groove",
+                      &Params::min_neighbors, 3, 100000));
+  s.push_back({"viewpoint", "sensor origin X,Y,Z in the cloud's frame (m); default: PCD "
+                            "VIEWPOINT, else the origin",
+               [](Params& p, const std::string& t) {
+                 std::stringstream ss(t);
+                 std::string part;
+                 std::vector<double> v;
+                 while (std::getline(ss, part, ',')) v.push_back(parse_number("viewpoint", part));
+                 if (v.size() != 3) {
+                   throw UsageError("viewpoint: expected X,Y,Z (three numbers), got '" + t + "'");
+                 }
+                 p.viewpoint = Eigen::Vector3f(v[0], v[1], v[2]);
+               },
+               [](const Params& p) {
+                 if (!p.viewpoint) return std::string("null");
+                 return "[" + num((*p.viewpoint).x()) + "," + num((*p.viewpoint).y()) + "," +
+                        num((*p.viewpoint).z()) + "]";
+               }});
+  s.push_back({"threshold", "descriptor threshold T (deg^2; paper 4.5-5) or auto (Otsu on log D)",
+               [](Params& p, const std::string& t) {
+                 if (trim(t) == "auto") {
+                   p.threshold_auto = true;
+                 } else {
+                   p.threshold = in_range("threshold", t, 0.0, 1e6, " deg^2");
+                   p.threshold_auto = false;
+                 }
+               },
+               [](const Params& p) {
+                 return p.threshold_auto ? quoted("auto") : num(p.threshold);
+               }});
+  s.push_back(integer("min_component", "groove parts with fewer points are dropped",
+                      &Params::min_component, 1, 100000000));
+  s.push_back(length("link_distance", "max gap within one groove part; 0 = radius",
+                     &Params::link_distance, 0.0, 0.1));
+  s.push_back(integer("slices", "slices along the groove, one waypoint each", &Params::slices,
+                      2, 100000));
+  s.push_back(integer("median_max_iterations", "geometric-median iteration cap",
+                      &Params::median_max_iterations, 1, 1000000));
+  s.push_back(length("median_tolerance", "geometric-median stop step", &Params::median_tolerance,
+                     1e-12, 1e-3));
+  s.push_back(length("approach_offset", "approach and retreat distance along -tool z",
+                     &Params::approach_offset, 0.0, 1.0));
+  s.push_back(real("approach_speed", "approach and retreat speed", &Params::approach_speed,
+                   1e-4, 3.0, "m/s"));
+  s.push_back(real("weld_speed", "travel speed along the seam", &Params::weld_speed, 1e-5, 1.0,
+                   "m/s"));
+  s.push_back(real("acceleration", "tool acceleration", &Params::acceleration, 1e-3, 10.0,
+                   "m/s^2"));
+  s.push_back(length("blend_radius", "movep blend radius, capped at 0.4 of the shorter segment",
+                     &Params::blend_radius, 0.0, 0.1));
+  s.push_back(integer("arc_output", "standard digital output that switches the arc",
+                      &Params::arc_output, 0, 7));
+  s.push_back(real("arc_delay", "wait after arc on", &Params::arc_delay, 0.0, 60.0, "s"));
+  s.push_back(path("hand_eye", "T_flange_camera file (YAML/JSON, docs/frames.md)",
+                   &Params::hand_eye_file));
+  s.push_back(path("flange_pose", "T_base_flange at capture (YAML/JSON, docs/frames.md)",
+                   &Params::flange_pose_file));
+  return s;
+}
+
+std::string underscored(std::string key) {
+  for (char& c : key) {
+    if (c == '-') c = '_';
+  }
+  return key;
+}
+
+}  // namespace
+
+const std::vector<ParamSpec>& param_specs() {
+  static const std::vector<ParamSpec> specs = build_specs();
+  return specs;
+}
+
+void set_param(Params& params, const std::string& key, const std::string& value) {
+  const std::string k = underscored(key);
+  for (const auto& spec : param_specs()) {
+    if (spec.key == k) {
+      spec.set(params, value);
+      return;
+    }
+  }
+  throw UsageError("unknown parameter '" + key + "'");
+}
+
+void apply_config_file(Params& params, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot read config file " + path);
+  std::stringstream buf;
+  buf << in.rdbuf();
+  std::vector<std::pair<std::string, std::string>> entries;
+  const auto dot = path.find_last_of('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  if (ext == ".json") {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(buf.str());
+    } catch (const std::exception& e) {
+      throw InputError("config file " + path + " is not valid JSON");
+    }
+    if (!j.is_object()) throw InputError("config file " + path + " must hold a JSON object");
+    for (const auto& [k, v] : j.items()) {
+      if (v.is_string()) {
+        entries.emplace_back(k, v.get<std::string>());
+      } else if (v.is_array()) {
+        std::string joined;
+        for (const auto& e : v) joined += (joined.empty() ? "" : ",") + e.dump();
+        entries.emplace_back(k, joined);
+      } else {
+        entries.emplace_back(k, v.dump());
+      }
+    }
+  } else if (ext == ".yaml" || ext == ".yml") {
+    YAML::Node root;
+    try {
+      root = YAML::Load(buf.str());
+    } catch (const std::exception& e) {
+      throw InputError("config file " + path + " is not valid YAML");
+    }
+    if (root.IsNull()) return;
+    if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
+    for (const auto& kv : root) {
+      const std::string k = kv.first.as<std::string>();
+      if (kv.second.IsSequence()) {
+        std::string joined;
+        for (const auto& e : kv.second) joined += (joined.empty() ? "" : ",") + e.as<std::string>();
+        entries.emplace_back(k, joined);
+      } else if (kv.second.IsScalar()) {
+        entries.emplace_back(k, kv.second.as<std::string>());
+      } else {
+        throw UsageError("config file " + path + ": " + k + " must be a value or a list");
+      }
+    }
+  } else {
+    throw InputError("config file " + path + " must end in .yaml, .yml or .json");
+  }
+  for (const auto& [k, v] : entries) {
+    try {
+      set_param(params, k, v);
+    } catch (const UsageError& e) {
+      throw UsageError("config file " + path + ": " + e.what());
+    }
+  }
+}
+
+std::string params_json(const Params& params) {
+  std::string out = "{";
+  bool first = true;
+  for (const auto& spec : param_specs()) {
+    out += (first ? "\"" : ",\"") + spec.key + "\":" + spec.json(params);
+    first = false;
+  }
+  return out + "}";
+}
+
+}  // namespace groovetrace
