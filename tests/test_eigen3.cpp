@@ -3,6 +3,7 @@
 #include <groovetrace/eigen3.hpp>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <random>
 
 namespace groovetrace {
@@ -67,7 +68,7 @@ TEST(Eigen3, DegenerateMatrices) {
   const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 3).normalized();
   expect_decomposition(n * n.transpose(), 1e-9);
   // Rank 2: a perfect plane's covariance; its smallest eigenvector is the plane normal.
-  const Eigen::Vector3d a = Eigen::Vector3d(1, -1, 0).normalized(), b = n.cross(a);
+  const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
   const Eigen::Matrix3d plane = a * a.transpose() + 0.5 * b * b.transpose();
   expect_decomposition(plane, 1e-9);
   EXPECT_NEAR(std::abs(smallest_eigenvector(plane).dot(n)), 1.0, 1e-9);

@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 

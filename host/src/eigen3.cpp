@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace groovetrace {
@@ -115,10 +116,17 @@ SymEigen3 eigen_sym3(const Eigen::Matrix3d& m_in) {
     v_mid = second_vector(a, v_min, l_mid);
     v_max = v_mid.cross(v_min);
   }
-  out.values = Eigen::Vector3d(l_min, l_mid, l_max) * scale;
-  out.vectors.col(0) = v_min;
-  out.vectors.col(1) = v_mid;
-  out.vectors.col(2) = v_max;
+  // acos loses half the digits where two eigenvalues meet (its slope is infinite at +-1);
+  // the Rayleigh quotients of the (accurate) vectors restore full precision.
+  std::array<std::pair<double, Eigen::Vector3d>, 3> pairs = {
+      std::make_pair(v_min.dot(a * v_min), v_min), std::make_pair(v_mid.dot(a * v_mid), v_mid),
+      std::make_pair(v_max.dot(a * v_max), v_max)};
+  std::sort(pairs.begin(), pairs.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (int k = 0; k < 3; ++k) {
+    out.values(k) = pairs[k].first * scale;
+    out.vectors.col(k) = pairs[k].second;
+  }
   return out;
 }
 
