@@ -5,6 +5,8 @@
 #include <groovetrace/cloud.hpp>
 
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace groovetrace {
@@ -12,10 +14,13 @@ namespace groovetrace {
 /// One torch pose. Tool frame: z along the torch into the workpiece (= -mean surface
 /// normal), x along the travel direction, y = z cross x.
 struct Waypoint {
-  Eigen::Vector3d position;        ///< metres, in the trajectory's frame
-  Eigen::Quaterniond orientation;  ///< rotation of the tool frame in the trajectory's frame
-  Eigen::Vector3d rotation_vector; ///< UR axis-angle (rad), continuous along the path
-  Eigen::Vector3d euler_zyx_deg;   ///< yaw, pitch, roll (deg): R = Rz(yaw) Ry(pitch) Rx(roll)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< metres, in the trajectory's frame
+  /// Rotation of the tool frame in the trajectory's frame.
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  /// UR axis-angle (rad), continuous along the path.
+  Eigen::Vector3d rotation_vector = Eigen::Vector3d::Zero();
+  /// Yaw, pitch, roll (deg): R = Rz(yaw) Ry(pitch) Rx(roll).
+  Eigen::Vector3d euler_zyx_deg = Eigen::Vector3d::Zero();
   int support = 0;                 ///< groove points in this waypoint's slice
 };
 
@@ -30,6 +35,7 @@ struct Trajectory {
 /// Geometric median (minimum sum of distances) of `points` by Weiszfeld's iteration, which
 /// is gradient descent with the step that makes it monotone. Stops when a step moves less
 /// than `tolerance` (same unit as the points) or after `max_iterations`.
+/// Throws std::invalid_argument for an empty set.
 Eigen::Vector3d geometric_median(const std::vector<Eigen::Vector3d>& points,
                                  int max_iterations = 1000, double tolerance = 1e-7);
 
@@ -37,7 +43,7 @@ Eigen::Vector3d geometric_median(const std::vector<Eigen::Vector3d>& points,
 /// The direction is the first principal axis of those points, signed so that it points
 /// along +x of the cloud's frame (+y if the axis is perpendicular to x); `slices` equal
 /// slices along it each give one waypoint (empty slices give none).
-/// Throws NoGrooveError if fewer than 2 waypoints result.
+/// Throws NoGrooveError if fewer than 2 waypoints result, UsageError for slices < 1.
 Trajectory paper_trajectory(const Cloud& cloud, const Normals& normals,
                             const std::vector<std::uint8_t>& mask, int slices,
                             int median_max_iterations = 1000, double median_tolerance = 1e-7);
