@@ -107,17 +107,9 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
                         ", no connected part of " + std::to_string(params.min_component) +
                         " or more");
   }
-  if (r.detection.components > 1) {
-    r.warnings.push_back(std::to_string(r.detection.components) +
-                         " separate groove parts found; the trajectory follows the largest (" +
-                         std::to_string(r.detection.component_sizes[0]) + " points)");
-  }
-
-  std::vector<std::uint8_t> largest(r.smoothed.size(), 0);
-  for (std::size_t i = 0; i < largest.size(); ++i) {
-    largest[i] = r.detection.component_label[i] == 0 ? 1 : 0;
-  }
-  r.trajectory = paper_trajectory(r.smoothed, r.normals, largest, params.slices,
+  // The paper slices every point that passed the threshold: a V's two top edges and its
+  // root are separate creases, often separate parts, and their median lies between them.
+  r.trajectory = paper_trajectory(r.smoothed, r.normals, r.detection.groove, params.slices,
                                   params.median_max_iterations, params.median_tolerance);
   if (T_base_camera) transform_trajectory(r.trajectory, *T_base_camera);
   timer.lap("trajectory");
