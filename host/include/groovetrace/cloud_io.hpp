@@ -17,8 +17,10 @@ struct ReadOptions {
 };
 
 /// Reads a PCD (ascii, binary, binary_compressed) or PLY file into a Cloud in metres.
-/// Organized PCDs (HEIGHT > 1) keep their layout; WIDTH N HEIGHT 1 is unorganized. NaN
-/// points stay in place. The PCD VIEWPOINT translation becomes cloud.viewpoint (scaled).
+/// Organized PCDs (HEIGHT > 1) keep their layout; WIDTH N HEIGHT 1 and WIDTH 1 HEIGHT N are
+/// unorganized. NaN points stay in place (a point with any NaN coordinate is all NaN). The
+/// PCD VIEWPOINT translation becomes cloud.viewpoint (scaled); PLY scans get the origin.
+/// Throws UsageError for a units_scale that is not positive and finite.
 /// Throws InputError (one line) for: missing or unreadable file, unknown extension, a
 /// malformed or truncated file, no x/y/z fields, no points, all points NaN, fewer than
 /// min_valid_points finite points, or any infinite coordinate.
@@ -33,7 +35,8 @@ struct Annotations {
 
 /// Binary PCD with fields `x y z normal_x normal_y normal_z descriptor groove` (groove as
 /// uint8), the points of `cloud` in its order and shape (width, height, viewpoint).
-/// Returns the file's bytes; write them with write_file_atomic.
+/// Returns the file's bytes; write them with write_file_atomic. Throws InternalError when
+/// the annotation sizes do not match the cloud or width * height != size.
 std::string annotated_pcd_bytes(const Cloud& cloud, const Annotations& annotations);
 
 /// Writes a plain XYZ binary PCD (organized if cloud is), e.g. for generated scans.
