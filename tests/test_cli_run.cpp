@@ -37,7 +37,7 @@ std::vector<CsvPose> read_trajectory_csv(const fs::path& path) {
 class CliRun : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = test::fresh_dir("cli_run");
+    dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
     test::VGrooveScene s;  // 640x480 at 0.4 m, 10 mm wide, 4 mm deep groove
     s.tilt_deg = 12;
     s.yaw_deg = 8;

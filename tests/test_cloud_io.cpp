@@ -384,10 +384,11 @@ TEST_F(CloudIo, DirectoryInsteadOfFile) {
 }
 
 TEST_F(CloudIo, UnreadableFile) {
-  const fs::path p = file("locked.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(120)));
-  ::chmod(p.c_str(), 0);
-  if (std::ifstream(p).good()) GTEST_SKIP() << "running as root: permissions do not apply";
-  expect_rejected(p, "Permission denied");
+  // Permissions do not stop root (CI runs as root), but reading /proc/self/mem from offset 0
+  // fails with an I/O error for everyone: a file that opens and cannot be read.
+  const fs::path p = dir_ / "locked.pcd";
+  fs::create_symlink("/proc/self/mem", p);
+  expect_rejected(p, "locked.pcd");
 }
 
 TEST_F(CloudIo, UnknownExtension) {
