@@ -11,10 +11,9 @@
 // left imager's centre; the right imager sits at (+baseline, 0, 0). `T_workpiece_camera`
 // maps camera coordinates to workpiece coordinates: p_workpiece = T_workpiece_camera * p_camera.
 
-#include <groovetrace/cloud.hpp>
-
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <groovetrace/cloud.hpp>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,15 +67,17 @@ std::string effects_string(const SensorEffects& effects);
 /// D415 constants of the sensor model. Defaults follow DESIGN.md; change them to model
 /// another stereo camera.
 struct SensorModel {
-  double hfov_deg = 65.0;  ///< horizontal field of view at every resolution (deg)
-  double vfov_deg = 40.0;  ///< vertical field of view of the native 16:9 frame (deg)
+  double hfov_deg = 65.0;              ///< horizontal field of view at every resolution (deg)
+  double vfov_deg = 40.0;              ///< vertical field of view of the native 16:9 frame (deg)
   double baseline = 0.055;             ///< left-right imager distance (m)
   double subpixel = 0.08;              ///< per-pixel disparity noise RMS (px)
+  bool correlate_noise = true;         ///< per-pixel noise correlated over the matching window
+                                       ///< (RMS unchanged); false: white noise
   double undulation_disparity = 0.10;  ///< correlated disparity error std (px); 0.45 mm at 0.5 m
   double undulation_min_wavelength = 0.010;  ///< undulation wavelengths (m, at the look-at
   double undulation_max_wavelength = 0.040;  ///< distance): half-waves of 5-20 mm
-  int blur_radius_1280 = 2;     ///< matching window half-width (px) at 1280 columns, scaled
-  double jump_disparity = 1.0;  ///< neighbours whose disparities differ more are a depth jump
+  int blur_radius_1280 = 2;          ///< matching window half-width (px) at 1280 columns, scaled
+  double jump_disparity = 1.0;       ///< neighbours whose disparities differ more are a depth jump
   double flying_probability = 0.35;  ///< chance that a pixel at a jump becomes a flying pixel
   double grazing_start_deg = 75.0;   ///< incidence where returns start to drop out
   double grazing_full_deg = 82.0;    ///< incidence beyond which nothing returns
@@ -89,17 +90,17 @@ struct SynthParams {
   Shape shape = Shape::kStraight;
   double groove_width = 0.010;     ///< top width of the V between its two top edges (m)
   double groove_angle_deg = 60.0;  ///< included angle between the two walls (deg)
-  double groove_depth = 0.0;  ///< depth of the V (m); > 0 overrides groove_angle_deg
-  double root_gap = 0.0005;   ///< gap between the two parts at the root (m)
-  double distance = 0.40;     ///< camera origin to the look-at point on the seam (m)
-  double tilt_deg = 0.0;      ///< camera pitch about its x axis, across the seam (deg)
-  double roll_deg = 0.0;      ///< camera roll about its optical axis (deg)
-  int width = 1280;           ///< image columns (D415 modes: 1280x720, 848x480, 640x480)
-  int height = 720;           ///< image rows
-  std::uint64_t seed = 1;     ///< every random choice comes from this
-  bool noise = true;          ///< false: ideal geometry, no sensor effect at all
-  SensorEffects effects;      ///< which effects apply when noise is on
-  double depth_unit = 0.001;  ///< depth quantisation step (m): 0.001 default, 0.0001 fine
+  double groove_depth = 0.0;       ///< depth of the V (m); > 0 overrides groove_angle_deg
+  double root_gap = 0.0005;        ///< gap between the two parts at the root (m)
+  double distance = 0.40;          ///< camera origin to the look-at point on the seam (m)
+  double tilt_deg = 0.0;           ///< camera pitch about its x axis, across the seam (deg)
+  double roll_deg = 0.0;           ///< camera roll about its optical axis (deg)
+  int width = 1280;                ///< image columns (D415 modes: 1280x720, 848x480, 640x480)
+  int height = 720;                ///< image rows
+  std::uint64_t seed = 1;          ///< every random choice comes from this
+  bool noise = true;               ///< false: ideal geometry, no sensor effect at all
+  SensorEffects effects;           ///< which effects apply when noise is on
+  double depth_unit = 0.001;       ///< depth quantisation step (m): 0.001 default, 0.0001 fine
   SensorModel sensor;
 };
 
@@ -136,13 +137,13 @@ CameraModel d415_camera(int width, int height, const SensorModel& sensor = {});
 /// One seam's true root line. Vertices are about 1 mm apart; a closed seam repeats its first
 /// vertex at the end. All vectors in the frame of the container (camera frame in SynthTruth).
 struct Seam {
-  std::vector<Eigen::Vector3d> root;    ///< root line (m): centre of the gap at the V's bottom
-  std::vector<Eigen::Vector3d> normal;  ///< unit surface normal of the part there, out of the
-                                        ///< workpiece (towards the camera side)
+  std::vector<Eigen::Vector3d> root;      ///< root line (m): centre of the gap at the V's bottom
+  std::vector<Eigen::Vector3d> normal;    ///< unit surface normal of the part there, out of the
+                                          ///< workpiece (towards the camera side)
   std::vector<Eigen::Vector3d> bisector;  ///< unit bisector of the two walls, out of the
                                           ///< groove; the tool z axis should be -bisector
-  std::vector<std::uint8_t> in_view;  ///< 1: inside the image where the sensor can return,
-                                      ///< facing the camera, the groove above it unhidden
+  std::vector<std::uint8_t> in_view;      ///< 1: inside the image where the sensor can return,
+                                          ///< facing the camera, the groove above it unhidden
   bool closed = false;
   double length() const;          ///< polyline length (m)
   double length_in_view() const;  ///< length of the segments with both ends in view (m)
@@ -197,8 +198,7 @@ class SynthScene {
                    double t_max) const;
   /// True if a surface lies between `from` and `to` closer than `tolerance` (m) to `from`'s
   /// side of `to` (i.e. `to` is hidden from `from`). Workpiece frame.
-  bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-                double tolerance) const;
+  bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double tolerance) const;
   /// Signed distance bound of the workpiece (m): <= 0 inside, > 0 outside, 1-Lipschitz (not
   /// the table).
   double signed_distance(const Eigen::Vector3d& p) const;
@@ -220,10 +220,10 @@ Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene
 
 /// What an ideal sensor sees, per pixel in row-major order.
 struct IdealFrame {
-  std::vector<double> depth;          ///< camera-frame z of the hit (m); NaN: no surface
-  std::vector<float> cos_incidence;   ///< |cos| of the angle between ray and surface normal
-  std::vector<std::uint8_t> label;    ///< groove-wall label of the hit surface
-  std::vector<std::uint8_t> shadowed; ///< 1: the right imager cannot see the hit point
+  std::vector<double> depth;           ///< camera-frame z of the hit (m); NaN: no surface
+  std::vector<float> cos_incidence;    ///< |cos| of the angle between ray and surface normal
+  std::vector<std::uint8_t> label;     ///< groove-wall label of the hit surface
+  std::vector<std::uint8_t> shadowed;  ///< 1: the right imager cannot see the hit point
 };
 
 /// Ray casts every pixel. Shadow rays only when noise and stereo_shadow are on.

@@ -1,0 +1,249 @@
+// Metrics of a detection and trajectory against synthetic ground truth (DESIGN.md "Metrics").
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <groovetrace/error.hpp>
+#include <groovetrace/eval.hpp>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  // atan2 of |cross| and dot stays accurate near 0 and 180 deg, where acos loses digits.
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
+}
+
+// The nearest point on the true root lines to a query, with the truth's frame there.
+struct RootPoint {
+  double distance = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d point, normal, bisector, tangent;
+};
+
+RootPoint nearest_root(const std::vector<Seam>& seams, const Eigen::Vector3d& q) {
+  RootPoint best;
+  for (const Seam& s : seams) {
+    for (std::size_t k = 0; k + 1 < s.root.size(); ++k) {
+      const Eigen::Vector3d a = s.root[k], ab = s.root[k + 1] - a;
+      const double l2 = ab.squaredNorm();
+      if (l2 <= 0.0) continue;
+      const double t = std::clamp((q - a).dot(ab) / l2, 0.0, 1.0);
+      const Eigen::Vector3d p = a + t * ab;
+      const double d = (q - p).norm();
+      if (d < best.distance) {
+        best.distance = d;
+        best.point = p;
+        best.normal = ((1 - t) * s.normal[k] + t * s.normal[k + 1]).normalized();
+        best.bisector = ((1 - t) * s.bisector[k] + t * s.bisector[k + 1]).normalized();
+        best.tangent = ab / std::sqrt(l2);
+      }
+    }
+  }
+  return best;
+}
+
+double distance_to_polyline(const std::vector<ToolPose>& poses, const Eigen::Vector3d& q) {
+  if (poses.size() == 1) return (q - poses[0].position).norm();
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k + 1 < poses.size(); ++k) {
+    const Eigen::Vector3d a = poses[k].position, ab = poses[k + 1].position - a;
+    const double l2 = ab.squaredNorm();
+    const double t = l2 > 0.0 ? std::clamp((q - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (q - (a + t * ab)).norm());
+  }
+  return best;
+}
+
+double percent(std::size_t num, std::size_t den) {
+  return den == 0 ? kNaN : 100.0 * static_cast<double>(num) / static_cast<double>(den);
+}
+
+}  // namespace
+
+EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
+                     const std::vector<ToolPose>& poses, const EvalOptions& options) {
+  const std::size_t n = truth.label.size();
+  if (detected.size() != n || truth.valid.size() != n)
+    throw InputError("eval: the detection has " + std::to_string(detected.size()) +
+                     " points, the truth " + std::to_string(n));
+  EvalMetrics m;
+  m.points = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!truth.valid[i]) continue;
+    ++m.valid_points;
+    const bool t = truth.label[i] != 0, d = detected[i] != 0;
+    m.truth_points += t;
+    m.detected_points += d;
+    m.overlap_points += t && d;
+  }
+  m.iou_percent = percent(m.overlap_points, m.detected_points + m.truth_points - m.overlap_points);
+  m.precision_percent = percent(m.overlap_points, m.detected_points);
+  m.recall_percent = percent(m.overlap_points, m.truth_points);
+
+  // Waypoints against the root lines.
+  m.waypoints = poses.size();
+  m.distance_mean = m.distance_max = m.lateral_mean = m.lateral_max = kNaN;
+  m.depth_mean = m.depth_max = m.depth_bias = kNaN;
+  m.tool_axis_mean_deg = m.tool_axis_max_deg = kNaN;
+  m.travel_axis_mean_deg = m.travel_axis_max_deg = kNaN;
+  bool any_root = false;
+  for (const Seam& s : truth.seams) any_root = any_root || s.root.size() >= 2;
+  if (!poses.empty() && any_root) {
+    double dist = 0, lat = 0, dep = 0, bias = 0, tool = 0, travel = 0;
+    m.distance_max = m.lateral_max = m.depth_max = 0;
+    m.tool_axis_max_deg = m.travel_axis_max_deg = 0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const Eigen::Vector3d& p = poses[k].position;
+      const RootPoint r = nearest_root(truth.seams, p);
+      const Eigen::Vector3d e = p - r.point;
+      const Eigen::Vector3d across = r.tangent.cross(r.normal).normalized();
+      const double lateral = std::abs(e.dot(across)), depth = e.dot(r.normal);
+      dist += r.distance;
+      lat += lateral;
+      dep += std::abs(depth);
+      bias += depth;
+      m.distance_max = std::max(m.distance_max, r.distance);
+      m.lateral_max = std::max(m.lateral_max, lateral);
+      m.depth_max = std::max(m.depth_max, std::abs(depth));
+
+      const Eigen::Matrix3d R = poses[k].orientation.normalized().toRotationMatrix();
+      const double tool_err = angle_deg(R.col(2), -r.bisector);
+      // The direction of travel here, from the neighbouring waypoints.
+      const Eigen::Vector3d ahead =
+          poses[std::min(k + 1, poses.size() - 1)].position - poses[k == 0 ? 0 : k - 1].position;
+      Eigen::Vector3d tangent = r.tangent;
+      double travel_err = 0;
+      if (ahead.norm() > 0.0) {
+        if (tangent.dot(ahead) < 0) tangent = -tangent;
+        travel_err = angle_deg(R.col(0), tangent);
+      } else {  // a single waypoint has no travel direction: either sense of the seam
+        travel_err = std::min(angle_deg(R.col(0), tangent), angle_deg(R.col(0), -tangent));
+      }
+      tool += tool_err;
+      travel += travel_err;
+      m.tool_axis_max_deg = std::max(m.tool_axis_max_deg, tool_err);
+      m.travel_axis_max_deg = std::max(m.travel_axis_max_deg, travel_err);
+    }
+    const double count = static_cast<double>(poses.size());
+    m.distance_mean = dist / count;
+    m.lateral_mean = lat / count;
+    m.depth_mean = dep / count;
+    m.depth_bias = bias / count;
+    m.tool_axis_mean_deg = tool / count;
+    m.travel_axis_mean_deg = travel / count;
+  }
+
+  // Coverage: the in-view root length whose points lie within the radius of the path.
+  m.coverage_radius = options.coverage_radius;
+  double total = 0.0, covered = 0.0;
+  for (const Seam& s : truth.seams) {
+    for (std::size_t k = 0; k + 1 < s.root.size(); ++k) {
+      if (!s.in_view[k] || !s.in_view[k + 1]) continue;
+      const Eigen::Vector3d a = s.root[k], ab = s.root[k + 1] - a;
+      const double length = ab.norm();
+      const int pieces = std::max(1, static_cast<int>(std::ceil(length / options.coverage_step)));
+      for (int j = 0; j < pieces; ++j) {
+        // Each piece is represented by its midpoint.
+        const Eigen::Vector3d q = a + ab * ((j + 0.5) / pieces);
+        total += length / pieces;
+        if (!poses.empty() && distance_to_polyline(poses, q) <= options.coverage_radius)
+          covered += length / pieces;
+      }
+    }
+  }
+  m.seam_length_in_view = total;
+  m.coverage_percent = total > 0.0 ? 100.0 * covered / total : kNaN;
+  m.runtime_ms = kNaN;
+  m.points_per_second = kNaN;
+  return m;
+}
+
+std::string metrics_json(const EvalMetrics& m, const std::string& truth,
+                         const std::string& result) {
+  using nlohmann::json;
+  json stages = json::object();
+  for (const auto& [name, ms] : m.stage_ms) stages[name] = ms;
+  const json j = {
+      {"truth", truth},
+      {"result", result},
+      {"units", "m, deg, percent"},
+      {"frame", "camera (trajectory assumed in the scan's camera frame)"},
+      {"detection",
+       {{"points", m.points},
+        {"valid_points", m.valid_points},
+        {"truth_points", m.truth_points},
+        {"detected_points", m.detected_points},
+        {"overlap_points", m.overlap_points},
+        {"iou_percent", m.iou_percent},
+        {"precision_percent", m.precision_percent},
+        {"recall_percent", m.recall_percent}}},
+      {"trajectory",
+       {{"waypoints", m.waypoints},
+        {"distance_mean_m", m.distance_mean},
+        {"distance_max_m", m.distance_max},
+        {"lateral_mean_m", m.lateral_mean},
+        {"lateral_max_m", m.lateral_max},
+        {"depth_mean_m", m.depth_mean},
+        {"depth_max_m", m.depth_max},
+        {"depth_bias_m", m.depth_bias},
+        {"tool_axis_mean_deg", m.tool_axis_mean_deg},
+        {"tool_axis_max_deg", m.tool_axis_max_deg},
+        {"travel_axis_mean_deg", m.travel_axis_mean_deg},
+        {"travel_axis_max_deg", m.travel_axis_max_deg},
+        {"coverage_percent", m.coverage_percent},
+        {"coverage_radius_m", m.coverage_radius},
+        {"seam_length_in_view_m", m.seam_length_in_view}}},
+      {"runtime",
+       {{"total_ms", m.runtime_ms},
+        {"points_per_second", m.points_per_second},
+        {"stages_ms", stages}}},
+      {"notes", m.notes},
+  };
+  return j.dump(2) + "\n";
+}
+
+std::string metrics_summary(const EvalMetrics& m) {
+  char buf[512];
+  std::string s;
+  std::snprintf(buf, sizeof buf,
+                "IoU %.2f %% (overlap %zu, detected %zu, truth %zu of %zu valid points; "
+                "precision %.2f %%, recall %.2f %%)\n",
+                m.iou_percent, m.overlap_points, m.detected_points, m.truth_points, m.valid_points,
+                m.precision_percent, m.recall_percent);
+  s += buf;
+  if (m.waypoints > 0 && std::isfinite(m.distance_mean)) {
+    std::snprintf(buf, sizeof buf,
+                  "%zu waypoints to the root: distance mean %.2f mm, max %.2f mm; lateral mean "
+                  "%.2f, max %.2f mm; depth mean %.2f, max %.2f, bias %+.2f mm\n",
+                  m.waypoints, m.distance_mean * 1e3, m.distance_max * 1e3, m.lateral_mean * 1e3,
+                  m.lateral_max * 1e3, m.depth_mean * 1e3, m.depth_max * 1e3, m.depth_bias * 1e3);
+    s += buf;
+    std::snprintf(buf, sizeof buf,
+                  "tool axis error mean %.2f deg, max %.2f deg; travel axis error mean %.2f "
+                  "deg, max %.2f deg\n",
+                  m.tool_axis_mean_deg, m.tool_axis_max_deg, m.travel_axis_mean_deg,
+                  m.travel_axis_max_deg);
+    s += buf;
+  } else {
+    s += "no waypoints\n";
+  }
+  std::snprintf(buf, sizeof buf, "coverage %.1f %% of %.1f mm root line in view (within %.1f mm)\n",
+                m.coverage_percent, m.seam_length_in_view * 1e3, m.coverage_radius * 1e3);
+  s += buf;
+  if (std::isfinite(m.runtime_ms)) {
+    std::snprintf(buf, sizeof buf, "runtime %.1f ms (%.0f points/s)\n", m.runtime_ms,
+                  m.points_per_second);
+    s += buf;
+  }
+  for (const std::string& note : m.notes) s += "note: " + note + "\n";
+  return s;
+}
+
+}  // namespace groovetrace

@@ -1,0 +1,263 @@
+// Reading a `groovetrace run` output directory for evaluation: annotated.pcd (the detection),
+// trajectory.csv (the poses), and, when present, trajectory.json (frame) and report.json
+// (timings).
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <groovetrace/error.hpp>
+#include <groovetrace/eval.hpp>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool read_file(const std::string& path, std::string& bytes) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return true;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(s);
+  while (std::getline(in, item, sep)) out.push_back(item);
+  return out;
+}
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+// Reads one field of a PCD as "nonzero" flags, plus WIDTH and HEIGHT. Supports the DATA kinds
+// `binary` and `ascii`, which is what `run` writes (binary) and what people hand-edit (ascii).
+std::vector<std::uint8_t> read_pcd_flag_field(const std::string& path, const std::string& field,
+                                              std::uint32_t& width, std::uint32_t& height) {
+  std::string bytes;
+  if (!read_file(path, bytes)) throw InputError("eval: cannot read " + path);
+  std::map<std::string, std::vector<std::string>> header;
+  std::size_t pos = 0;
+  std::string data;
+  while (pos < bytes.size()) {
+    std::size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos) end = bytes.size();
+    std::string line = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::vector<std::string> w = words(line);
+    if (w.empty() || w[0][0] == '#') continue;
+    header[w[0]] = std::vector<std::string>(w.begin() + 1, w.end());
+    if (w[0] == "DATA") {
+      data = w.size() > 1 ? w[1] : "";
+      break;
+    }
+  }
+  const auto& fields = header["FIELDS"];
+  const auto& sizes = header["SIZE"];
+  const auto& types = header["TYPE"];
+  std::vector<std::string> counts = header["COUNT"];
+  if (counts.empty()) counts.assign(fields.size(), "1");
+  if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() ||
+      counts.size() != fields.size() || header["WIDTH"].size() != 1 ||
+      header["HEIGHT"].size() != 1 || data.empty())
+    throw InputError("eval: " + path + " has a malformed PCD header");
+  width = static_cast<std::uint32_t>(std::strtoul(header["WIDTH"][0].c_str(), nullptr, 10));
+  height = static_cast<std::uint32_t>(std::strtoul(header["HEIGHT"][0].c_str(), nullptr, 10));
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+
+  std::size_t record = 0, offset = 0, column = 0, columns = 0, size = 0;
+  char type = 0;
+  bool found = false;
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const std::size_t sz = std::strtoul(sizes[f].c_str(), nullptr, 10);
+    const std::size_t ct = std::strtoul(counts[f].c_str(), nullptr, 10);
+    if (fields[f] == field) {
+      found = true;
+      offset = record;
+      column = columns;
+      size = sz;
+      type = types[f][0];
+    }
+    record += sz * ct;
+    columns += ct;
+  }
+  if (!found) throw InputError("eval: " + path + " has no '" + field + "' field");
+
+  std::vector<std::uint8_t> flags(n, 0);
+  if (data == "binary") {
+    if (bytes.size() < pos || bytes.size() - pos < n * record)
+      throw InputError("eval: " + path + " is truncated");
+    for (std::size_t i = 0; i < n; ++i) {
+      const char* p = bytes.data() + pos + i * record + offset;
+      bool nonzero = false;
+      if (type == 'F' && size == 4) {
+        float v;
+        std::memcpy(&v, p, 4);
+        nonzero = v != 0.0f;
+      } else if (type == 'F' && size == 8) {
+        double v;
+        std::memcpy(&v, p, 8);
+        nonzero = v != 0.0;
+      } else {  // integers: any nonzero byte
+        for (std::size_t b = 0; b < size; ++b) nonzero = nonzero || p[b] != 0;
+      }
+      flags[i] = nonzero ? 1 : 0;
+    }
+  } else if (data == "ascii") {
+    std::istringstream in(bytes.substr(pos));
+    std::string line;
+    std::size_t i = 0;
+    while (i < n && std::getline(in, line)) {
+      const std::vector<std::string> w = words(line);
+      if (w.empty()) continue;
+      if (w.size() != columns) throw InputError("eval: " + path + ": bad ascii point line");
+      flags[i++] = std::strtod(w[column].c_str(), nullptr) != 0.0 ? 1 : 0;
+    }
+    if (i != n) throw InputError("eval: " + path + " is truncated");
+  } else {
+    throw InputError("eval: " + path + ": DATA " + data + " is not supported (binary, ascii)");
+  }
+  return flags;
+}
+
+std::vector<ToolPose> read_trajectory_csv(const std::string& path) {
+  std::string bytes;
+  if (!read_file(path, bytes)) throw InputError("eval: cannot read " + path);
+  std::istringstream in(bytes);
+  std::string line;
+  if (!std::getline(in, line)) throw InputError("eval: " + path + " is empty");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const std::vector<std::string> head = split(line, ',');
+  const char* names[] = {"x_m", "y_m", "z_m", "qx", "qy", "qz", "qw"};
+  int col[7];
+  for (int k = 0; k < 7; ++k) {
+    col[k] = -1;
+    for (std::size_t c = 0; c < head.size(); ++c)
+      if (head[c] == names[k]) col[k] = static_cast<int>(c);
+    if (col[k] < 0) throw InputError("eval: " + path + " has no column " + names[k]);
+  }
+  std::vector<ToolPose> poses;
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = split(line, ',');
+    double v[7];
+    for (int k = 0; k < 7; ++k) {
+      char* end = nullptr;
+      const char* s = static_cast<std::size_t>(col[k]) < cells.size() ? cells[col[k]].c_str() : "";
+      v[k] = std::strtod(s, &end);
+      if (end == s || !std::isfinite(v[k]))
+        throw InputError("eval: " + path + " line " + std::to_string(row) + ": bad " + names[k]);
+    }
+    ToolPose p;
+    p.position = {v[0], v[1], v[2]};
+    p.orientation = Eigen::Quaterniond(v[6], v[3], v[4], v[5]).normalized();
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+// report.json is the run's business; accept the shapes a report plausibly has: a top-level
+// "total_ms", and stage timings as {"name": ms} or [{"name"/"stage": .., "ms": ..}] under a
+// key containing "timing" or "stage".
+void read_report(const nlohmann::json& j, RunOutput& out) {
+  using nlohmann::json;
+  if (!j.is_object()) return;
+  for (const char* key : {"total_ms", "end_to_end_ms", "wall_ms"})
+    if (j.contains(key) && j[key].is_number()) out.total_ms = j[key].get<double>();
+  for (const auto& [key, value] : j.items()) {
+    if (key.find("timing") == std::string::npos && key.find("stage") == std::string::npos) continue;
+    if (value.is_object()) {
+      for (const auto& [name, ms] : value.items()) {
+        if (!ms.is_number()) continue;
+        if (name == "total" || name == "total_ms")
+          out.total_ms = ms.get<double>();
+        else
+          out.stage_ms.emplace_back(name, ms.get<double>());
+      }
+    } else if (value.is_array()) {
+      for (const json& e : value) {
+        if (!e.is_object() || !e.contains("ms") || !e["ms"].is_number()) continue;
+        const std::string name = e.contains("name")    ? e["name"].get<std::string>()
+                                 : e.contains("stage") ? e["stage"].get<std::string>()
+                                                       : "?";
+        if (name == "total")
+          out.total_ms = e["ms"].get<double>();
+        else
+          out.stage_ms.emplace_back(name, e["ms"].get<double>());
+      }
+    }
+  }
+}
+
+}  // namespace
+
+RunOutput read_run_output(const std::string& result_dir) {
+  RunOutput out;
+  out.total_ms = kNaN;
+  const std::string dir =
+      result_dir.empty() || result_dir.back() == '/' ? result_dir : result_dir + "/";
+  out.groove = read_pcd_flag_field(dir + "annotated.pcd", "groove", out.width, out.height);
+
+  std::string bytes;
+  if (read_file(dir + "trajectory.csv", bytes)) {
+    out.poses = read_trajectory_csv(dir + "trajectory.csv");
+    out.has_trajectory = true;
+  }
+  if (read_file(dir + "trajectory.json", bytes)) {
+    const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
+    if (j.is_object() && j.contains("frame") && j["frame"].is_string())
+      out.frame = j["frame"].get<std::string>();
+  }
+  if (read_file(dir + "report.json", bytes)) {
+    const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
+    if (!j.is_discarded()) read_report(j, out);
+  }
+  return out;
+}
+
+EvalMetrics evaluate_files(const std::string& scan_path, const std::string& result_dir,
+                           const EvalOptions& options) {
+  const SynthTruth truth = read_synth_truth(scan_path);
+  const RunOutput run = read_run_output(result_dir);
+  if (run.groove.size() != truth.label.size() ||
+      run.width != static_cast<std::uint32_t>(truth.camera.width))
+    throw InputError("eval: " + result_dir + "/annotated.pcd has " + std::to_string(run.width) +
+                     "x" + std::to_string(run.height) + " points, the scan " +
+                     std::to_string(truth.camera.width) + "x" +
+                     std::to_string(truth.camera.height));
+  EvalMetrics m = evaluate(truth, run.groove, run.poses, options);
+  if (!run.has_trajectory) m.notes.push_back("no trajectory.csv: trajectory metrics undefined");
+  if (run.frame != "camera")
+    m.notes.push_back("the trajectory is in frame '" + run.frame +
+                      "', eval assumes the scan's camera frame: trajectory metrics are wrong");
+  double total = run.total_ms;
+  if (!std::isfinite(total) && !run.stage_ms.empty()) {
+    total = 0.0;
+    for (const auto& stage : run.stage_ms) total += stage.second;
+    m.notes.push_back("runtime is the sum of the reported stages");
+  }
+  m.runtime_ms = total;
+  m.points_per_second =
+      std::isfinite(total) && total > 0.0 ? static_cast<double>(m.points) / (total * 1e-3) : kNaN;
+  m.stage_ms = run.stage_ms;
+  return m;
+}
+
+}  // namespace groovetrace

@@ -1,0 +1,168 @@
+// Rendering a synthetic scan: camera pose, one ray per pixel, the sensor model, and the
+// truth (labels, and the seams' root lines with what of them the camera can see).
+
+#include <cmath>
+#include <groovetrace/error.hpp>
+#include <groovetrace/synth.hpp>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace groovetrace {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+// No ray travels further than this (m): the table is always closer.
+constexpr double kFar = 10.0;
+// A shadow ray that reaches within this distance of its target counts as reaching it (m).
+constexpr double kShadowTolerance = 1e-4;
+
+void require(bool ok, const std::string& what, double value, const std::string& range) {
+  if (ok) return;
+  std::ostringstream s;
+  s << "synth: " << what << " " << value << " is out of range (" << range << ")";
+  throw UsageError(s.str());
+}
+
+}  // namespace
+
+void validate(const SynthParams& p) {
+  require(std::isfinite(p.distance) && p.distance >= 0.2 && p.distance <= 1.5, "distance",
+          p.distance, "0.2-1.5 m; D415 scans: 0.3-0.6 m");
+  require(std::isfinite(p.tilt_deg) && std::abs(p.tilt_deg) <= 45.0, "tilt", p.tilt_deg,
+          "-45..45 deg");
+  require(std::isfinite(p.roll_deg) && std::abs(p.roll_deg) <= 180.0, "roll", p.roll_deg,
+          "-180..180 deg");
+  require(p.width >= 32 && p.width <= 4096, "width", p.width, "32-4096 px");
+  require(p.height >= 32 && p.height <= 4096, "height", p.height, "32-4096 px");
+  require(std::isfinite(p.groove_width) && p.groove_width >= 0.002 && p.groove_width <= 0.04,
+          "groove width", p.groove_width, "0.002-0.04 m");
+  require(std::isfinite(p.root_gap) && p.root_gap >= 0.0 && p.root_gap <= 0.003 &&
+              p.root_gap < p.groove_width,
+          "root gap", p.root_gap, "0-0.003 m and below the groove width");
+  if (p.groove_depth > 0.0) {
+    require(std::isfinite(p.groove_depth) && p.groove_depth >= 0.001 && p.groove_depth <= 0.03,
+            "groove depth", p.groove_depth, "0.001-0.03 m");
+  } else {
+    require(std::isfinite(p.groove_angle_deg) && p.groove_angle_deg >= 20.0 &&
+                p.groove_angle_deg <= 150.0,
+            "groove angle", p.groove_angle_deg, "20-150 deg");
+  }
+  require(std::isfinite(p.depth_unit) && p.depth_unit >= 1e-5 && p.depth_unit <= 0.01, "depth unit",
+          p.depth_unit, "1e-5-0.01 m; D415: 0.001 or 0.0001");
+  const GrooveGeometry g = groove_geometry(p);
+  require(g.depth <= 0.03, "groove depth", g.depth, "at most 0.03 m; widen the angle");
+}
+
+double Seam::length() const {
+  double l = 0.0;
+  for (std::size_t i = 1; i < root.size(); ++i) l += (root[i] - root[i - 1]).norm();
+  return l;
+}
+
+double Seam::length_in_view() const {
+  double l = 0.0;
+  for (std::size_t i = 1; i < root.size(); ++i)
+    if (in_view[i] && in_view[i - 1]) l += (root[i] - root[i - 1]).norm();
+  return l;
+}
+
+Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene) {
+  // Straight down with image x along the seam: camera x = +x, y = -y, z = -z (workpiece).
+  Eigen::Matrix3d down;
+  down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  const Eigen::Matrix3d R_workpiece_camera =
+      down * Eigen::AngleAxisd(params.tilt_deg * kDeg, Eigen::Vector3d::UnitX()) *
+      Eigen::AngleAxisd(params.roll_deg * kDeg, Eigen::Vector3d::UnitZ());
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R_workpiece_camera;
+  T.translation() = scene.look_at() - params.distance * R_workpiece_camera.col(2);
+  return T;
+}
+
+IdealFrame render_ideal(const SynthScene& scene, const CameraModel& camera,
+                        const Eigen::Isometry3d& T_workpiece_camera, const SynthParams& params) {
+  const int W = camera.width, H = camera.height;
+  const std::size_t N = static_cast<std::size_t>(W) * H;
+  IdealFrame f;
+  f.depth.assign(N, std::numeric_limits<double>::quiet_NaN());
+  f.cos_incidence.assign(N, 0.0f);
+  f.label.assign(N, 0);
+  f.shadowed.assign(N, 0);
+  const bool shadows = params.noise && params.effects.stereo_shadow;
+  const Eigen::Matrix3d R = T_workpiece_camera.linear();
+  const Eigen::Vector3d left = T_workpiece_camera.translation();
+  const Eigen::Vector3d right = T_workpiece_camera * Eigen::Vector3d(params.sensor.baseline, 0, 0);
+
+  // Rows differ in cost (the groove, silhouettes), hence dynamic scheduling.
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int v = 0; v < H; ++v) {
+    for (int u = 0; u < W; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * W + u;
+      const Eigen::Vector3d ray = camera.ray(u, v);
+      const double norm = ray.norm();
+      const Eigen::Vector3d dir = R * (ray / norm);
+      const RayHit hit = scene.intersect(left, dir, kFar);
+      if (!hit.hit) continue;
+      f.depth[i] = hit.t / norm;
+      f.cos_incidence[i] = static_cast<float>(std::abs(hit.normal.dot(dir)));
+      f.label[i] = hit.label;
+      if (shadows) f.shadowed[i] = scene.occluded(right, hit.point, kShadowTolerance) ? 1 : 0;
+    }
+  }
+  return f;
+}
+
+SynthScan render(const SynthParams& params) {
+  validate(params);
+  const SynthScene scene(params);
+  const CameraModel camera = d415_camera(params.width, params.height, params.sensor);
+  const Eigen::Isometry3d T_workpiece_camera = camera_pose(params, scene);
+  const IdealFrame ideal = render_ideal(scene, camera, T_workpiece_camera, params);
+
+  SynthScan scan;
+  scan.cloud = simulate_sensor(ideal, camera, params);
+
+  SynthTruth& truth = scan.truth;
+  truth.params = params;
+  truth.groove = scene.groove();
+  truth.camera = camera;
+  truth.T_workpiece_camera = T_workpiece_camera;
+  truth.label = ideal.label;
+  truth.valid.resize(scan.cloud.size());
+  for (std::size_t i = 0; i < scan.cloud.size(); ++i) truth.valid[i] = scan.cloud.valid(i) ? 1 : 0;
+
+  // A root vertex is in view when a detector could find the groove there: inside the image
+  // where the sensor returns depth, facing the camera, and the groove's opening above it not
+  // hidden by the workpiece.
+  const Eigen::Isometry3d T_camera_workpiece = T_workpiece_camera.inverse();
+  const Eigen::Vector3d eye = T_workpiece_camera.translation();
+  const bool sensor_limits = params.noise;
+  for (Seam seam : scene.seams()) {
+    for (std::size_t k = 0; k < seam.root.size(); ++k) {
+      const Eigen::Vector3d& p = seam.root[k];
+      const Eigen::Vector3d c = T_camera_workpiece * p;
+      bool in = c.z() > 0.0;
+      if (in) {
+        const double u = camera.fx * c.x() / c.z() + camera.cx;
+        const double v = camera.fy * c.y() / c.z() + camera.cy;
+        in = u >= 0.0 && u <= camera.width - 1.0 && v >= 0.0 && v <= camera.height - 1.0;
+        if (sensor_limits && params.effects.left_band)
+          in = in && u >= camera.fx * params.sensor.baseline / c.z();
+        if (sensor_limits && params.effects.min_z) in = in && c.z() >= params.sensor.min_z;
+      }
+      in = in && seam.normal[k].dot(eye - p) > 0.0;
+      const Eigen::Vector3d opening = p + truth.groove.depth * seam.bisector[k];
+      in = in && !scene.occluded(eye, opening, kShadowTolerance);
+      seam.in_view[k] = in ? 1 : 0;
+      seam.root[k] = c;
+      seam.normal[k] = T_camera_workpiece.linear() * seam.normal[k];
+      seam.bisector[k] = T_camera_workpiece.linear() * seam.bisector[k];
+    }
+    truth.seams.push_back(std::move(seam));
+  }
+  return scan;
+}
+
+}  // namespace groovetrace

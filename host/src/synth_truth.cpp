@@ -1,0 +1,307 @@
+// The files of a synthetic scan: SCAN.pcd, SCAN.truth.json and SCAN.labels.pcd
+// (format in docs/synthetic-scans.md), written and read back.
+
+#include <cmath>
+#include <fstream>
+#include <groovetrace/cloud_io.hpp>
+#include <groovetrace/error.hpp>
+#include <groovetrace/synth.hpp>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kTruthFormat = "groovetrace-synth-truth";
+constexpr int kTruthVersion = 1;
+
+std::string base_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string dir_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+Eigen::Vector3d to_vec(const json& j) {
+  if (!j.is_array() || j.size() != 3) throw InputError("truth: expected a 3-vector");
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+json params_json(const SynthParams& p) {
+  const SensorModel& m = p.sensor;
+  return json{
+      {"shape", shape_name(p.shape)},
+      {"groove_width_m", p.groove_width},
+      {"groove_angle_deg", p.groove_angle_deg},
+      {"groove_depth_m", p.groove_depth},
+      {"root_gap_m", p.root_gap},
+      {"distance_m", p.distance},
+      {"tilt_deg", p.tilt_deg},
+      {"roll_deg", p.roll_deg},
+      {"width", p.width},
+      {"height", p.height},
+      {"seed", p.seed},
+      {"noise", p.noise},
+      {"effects", effects_string(p.effects)},
+      {"depth_unit_m", p.depth_unit},
+      {"sensor",
+       {{"hfov_deg", m.hfov_deg},
+        {"vfov_deg", m.vfov_deg},
+        {"baseline_m", m.baseline},
+        {"subpixel_px", m.subpixel},
+        {"correlate_noise", m.correlate_noise},
+        {"undulation_disparity_px", m.undulation_disparity},
+        {"undulation_min_wavelength_m", m.undulation_min_wavelength},
+        {"undulation_max_wavelength_m", m.undulation_max_wavelength},
+        {"blur_radius_1280_px", m.blur_radius_1280},
+        {"jump_disparity_px", m.jump_disparity},
+        {"flying_probability", m.flying_probability},
+        {"grazing_start_deg", m.grazing_start_deg},
+        {"grazing_full_deg", m.grazing_full_deg},
+        {"dropout_probability", m.dropout_probability},
+        {"min_z_m", m.min_z}}},
+  };
+}
+
+SynthParams params_from_json(const json& j) {
+  SynthParams p;
+  p.shape = parse_shape(j.at("shape").get<std::string>());
+  p.groove_width = j.at("groove_width_m").get<double>();
+  p.groove_angle_deg = j.at("groove_angle_deg").get<double>();
+  p.groove_depth = j.at("groove_depth_m").get<double>();
+  p.root_gap = j.at("root_gap_m").get<double>();
+  p.distance = j.at("distance_m").get<double>();
+  p.tilt_deg = j.at("tilt_deg").get<double>();
+  p.roll_deg = j.at("roll_deg").get<double>();
+  p.width = j.at("width").get<int>();
+  p.height = j.at("height").get<int>();
+  p.seed = j.at("seed").get<std::uint64_t>();
+  p.noise = j.at("noise").get<bool>();
+  p.effects = parse_effects(j.at("effects").get<std::string>());
+  p.depth_unit = j.at("depth_unit_m").get<double>();
+  const json& s = j.at("sensor");
+  SensorModel& m = p.sensor;
+  m.hfov_deg = s.at("hfov_deg").get<double>();
+  m.vfov_deg = s.at("vfov_deg").get<double>();
+  m.baseline = s.at("baseline_m").get<double>();
+  m.subpixel = s.at("subpixel_px").get<double>();
+  m.correlate_noise = s.at("correlate_noise").get<bool>();
+  m.undulation_disparity = s.at("undulation_disparity_px").get<double>();
+  m.undulation_min_wavelength = s.at("undulation_min_wavelength_m").get<double>();
+  m.undulation_max_wavelength = s.at("undulation_max_wavelength_m").get<double>();
+  m.blur_radius_1280 = s.at("blur_radius_1280_px").get<int>();
+  m.jump_disparity = s.at("jump_disparity_px").get<double>();
+  m.flying_probability = s.at("flying_probability").get<double>();
+  m.grazing_start_deg = s.at("grazing_start_deg").get<double>();
+  m.grazing_full_deg = s.at("grazing_full_deg").get<double>();
+  m.dropout_probability = s.at("dropout_probability").get<double>();
+  m.min_z = s.at("min_z_m").get<double>();
+  return p;
+}
+
+std::string read_file(const std::string& path, const char* what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(std::string("cannot read ") + what + " " + path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+SynthFiles synth_files(const std::string& scan_path) {
+  const std::string ext = ".pcd";
+  if (scan_path.size() <= ext.size() ||
+      scan_path.compare(scan_path.size() - ext.size(), ext.size(), ext) != 0 ||
+      base_name(scan_path) == ext)
+    throw UsageError("synth: the scan's file name must end in .pcd, got '" + scan_path + "'");
+  const std::string stem = scan_path.substr(0, scan_path.size() - ext.size());
+  return {scan_path, stem + ".truth.json", stem + ".labels.pcd"};
+}
+
+std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
+                       const std::string& labels_name) {
+  std::size_t valid = 0, labelled = 0, labelled_valid = 0;
+  for (std::size_t i = 0; i < truth.label.size(); ++i) {
+    valid += truth.valid[i];
+    labelled += truth.label[i] ? 1 : 0;
+    labelled_valid += truth.label[i] && truth.valid[i] ? 1 : 0;
+  }
+  json seams = json::array();
+  for (const Seam& s : truth.seams) {
+    json root = json::array(), normal = json::array(), bisector = json::array();
+    for (std::size_t k = 0; k < s.root.size(); ++k) {
+      root.push_back(vec(s.root[k]));
+      normal.push_back(vec(s.normal[k]));
+      bisector.push_back(vec(s.bisector[k]));
+    }
+    seams.push_back({{"closed", s.closed},
+                     {"length_m", s.length()},
+                     {"length_in_view_m", s.length_in_view()},
+                     {"root", root},
+                     {"normal", normal},
+                     {"bisector", bisector},
+                     {"in_view", s.in_view}});
+  }
+  const Eigen::Matrix4d T = truth.T_workpiece_camera.matrix();
+  json pose = json::array();
+  for (int r = 0; r < 4; ++r) pose.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
+  const CameraModel& c = truth.camera;
+  const GrooveGeometry& g = truth.groove;
+  const json j = {
+      {"format", kTruthFormat},
+      {"version", kTruthVersion},
+      {"units", "m"},
+      {"frame", "camera: x right, y down, z forward; origin at the left imager"},
+      {"files", {{"scan", scan_name}, {"labels", labels_name}}},
+      {"params", params_json(truth.params)},
+      {"groove",
+       {{"top_width_m", g.top_width},
+        {"depth_m", g.depth},
+        {"included_angle_deg", g.included_angle_deg},
+        {"root_gap_m", g.root_gap},
+        {"thickness_m", g.thickness}}},
+      {"camera",
+       {{"width", c.width},
+        {"height", c.height},
+        {"fx", c.fx},
+        {"fy", c.fy},
+        {"cx", c.cx},
+        {"cy", c.cy},
+        {"baseline_m", truth.params.sensor.baseline}}},
+      {"T_workpiece_camera", pose},
+      {"counts",
+       {{"points", truth.label.size()},
+        {"valid", valid},
+        {"groove_labelled", labelled},
+        {"groove_valid", labelled_valid}}},
+      {"seams", seams},
+  };
+  return j.dump() + "\n";
+}
+
+std::string labels_pcd_bytes(const SynthTruth& truth) {
+  const std::size_t n = truth.label.size();
+  std::ostringstream h;
+  h << "# .PCD v0.7 - groovetrace synth labels: label (1 = groove wall), valid (1 = return)\n"
+    << "VERSION 0.7\nFIELDS label valid\nSIZE 1 1\nTYPE U U\nCOUNT 1 1\n"
+    << "WIDTH " << truth.camera.width << "\nHEIGHT " << truth.camera.height << "\n"
+    << "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA binary\n";
+  std::string bytes = h.str();
+  const std::size_t offset = bytes.size();
+  bytes.resize(offset + 2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    bytes[offset + 2 * i] = static_cast<char>(truth.label[i]);
+    bytes[offset + 2 * i + 1] = static_cast<char>(truth.valid[i]);
+  }
+  return bytes;
+}
+
+SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path) {
+  const SynthFiles files = synth_files(scan_path);
+  // Truth first: a scan that exists always has its truth beside it.
+  write_file_atomic(files.labels, labels_pcd_bytes(scan.truth));
+  write_file_atomic(files.truth,
+                    truth_json(scan.truth, base_name(files.scan), base_name(files.labels)));
+  write_file_atomic(files.scan, pcd_bytes(scan.cloud));
+  return files;
+}
+
+SynthTruth read_synth_truth(const std::string& scan_path) {
+  SynthFiles files;
+  try {
+    files = synth_files(scan_path);
+  } catch (const UsageError&) {
+    throw InputError("truth: '" + scan_path + "' is not a .pcd scan path");
+  }
+  SynthTruth truth;
+  json j;
+  try {
+    j = json::parse(read_file(files.truth, "truth file"));
+  } catch (const json::exception& e) {
+    throw InputError("truth: " + files.truth + " is not valid JSON: " + e.what());
+  }
+  try {
+    if (j.at("format").get<std::string>() != kTruthFormat)
+      throw InputError("truth: " + files.truth + " is not a groovetrace truth file");
+    truth.params = params_from_json(j.at("params"));
+    const json& g = j.at("groove");
+    truth.groove.top_width = g.at("top_width_m").get<double>();
+    truth.groove.depth = g.at("depth_m").get<double>();
+    truth.groove.included_angle_deg = g.at("included_angle_deg").get<double>();
+    truth.groove.root_gap = g.at("root_gap_m").get<double>();
+    truth.groove.thickness = g.at("thickness_m").get<double>();
+    const json& c = j.at("camera");
+    truth.camera.width = c.at("width").get<int>();
+    truth.camera.height = c.at("height").get<int>();
+    truth.camera.fx = c.at("fx").get<double>();
+    truth.camera.fy = c.at("fy").get<double>();
+    truth.camera.cx = c.at("cx").get<double>();
+    truth.camera.cy = c.at("cy").get<double>();
+    const json& pose = j.at("T_workpiece_camera");
+    Eigen::Matrix4d T;
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < 4; ++k) T(r, k) = pose.at(r).at(k).get<double>();
+    truth.T_workpiece_camera.matrix() = T;
+    for (const json& s : j.at("seams")) {
+      Seam seam;
+      seam.closed = s.at("closed").get<bool>();
+      for (const json& v : s.at("root")) seam.root.push_back(to_vec(v));
+      for (const json& v : s.at("normal")) seam.normal.push_back(to_vec(v));
+      for (const json& v : s.at("bisector")) seam.bisector.push_back(to_vec(v));
+      seam.in_view = s.at("in_view").get<std::vector<std::uint8_t>>();
+      if (seam.normal.size() != seam.root.size() || seam.bisector.size() != seam.root.size() ||
+          seam.in_view.size() != seam.root.size())
+        throw InputError("truth: " + files.truth + ": seam arrays differ in length");
+      truth.seams.push_back(std::move(seam));
+    }
+  } catch (const json::exception& e) {
+    throw InputError("truth: " + files.truth + ": " + e.what());
+  } catch (const UsageError& e) {
+    throw InputError("truth: " + files.truth + ": " + e.what());
+  }
+
+  // The labels file: a header of "KEY values" lines up to DATA, then 2 bytes per point.
+  std::string labels_path = files.labels;
+  if (j.contains("files") && j["files"].contains("labels"))
+    labels_path = dir_name(files.truth) + j["files"]["labels"].get<std::string>();
+  const std::string bytes = read_file(labels_path, "labels file");
+  std::map<std::string, std::string> header;
+  std::size_t pos = 0;
+  while (pos < bytes.size()) {
+    const std::size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos) break;
+    const std::string line = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    if (line.empty() || line[0] == '#') continue;
+    const std::size_t space = line.find(' ');
+    header[line.substr(0, space)] = space == std::string::npos ? "" : line.substr(space + 1);
+    if (line.rfind("DATA", 0) == 0) break;
+  }
+  const std::size_t n = static_cast<std::size_t>(truth.camera.width) * truth.camera.height;
+  if (header["FIELDS"] != "label valid" || header["SIZE"] != "1 1" || header["TYPE"] != "U U" ||
+      header["DATA"] != "binary" || header["POINTS"] != std::to_string(n) ||
+      header["WIDTH"] != std::to_string(truth.camera.width))
+    throw InputError("truth: " + labels_path + " is not a labels file for a " +
+                     std::to_string(truth.camera.width) + "x" +
+                     std::to_string(truth.camera.height) + " scan");
+  if (bytes.size() - pos < 2 * n) throw InputError("truth: " + labels_path + " is truncated");
+  truth.label.resize(n);
+  truth.valid.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    truth.label[i] = static_cast<std::uint8_t>(bytes[pos + 2 * i]) ? 1 : 0;
+    truth.valid[i] = static_cast<std::uint8_t>(bytes[pos + 2 * i + 1]) ? 1 : 0;
+  }
+  return truth;
+}
+
+}  // namespace groovetrace

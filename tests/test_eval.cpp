@@ -1,0 +1,270 @@
+// Metrics on hand-made cases with known answers, and the file reader on a hand-made run.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <groovetrace/error.hpp>
+#include <groovetrace/eval.hpp>
+#include <groovetrace/synth.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace gt = groovetrace;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A 20 x 10 "scan" whose truth labels 40 points, and one straight seam in the camera frame:
+// from x = -0.1 to 0.1 m at y = 0, z = 0.4, the surface facing the camera (normal -z).
+gt::SynthTruth hand_truth() {
+  gt::SynthTruth t;
+  t.camera.width = 20;
+  t.camera.height = 10;
+  t.label.assign(200, 0);
+  t.valid.assign(200, 1);
+  for (int i = 80; i < 120; ++i) t.label[i] = 1;  // rows 4 and 5
+  gt::Seam s;
+  for (int k = 0; k <= 200; ++k) {
+    s.root.emplace_back(-0.1 + 0.001 * k, 0.0, 0.4);
+    s.normal.emplace_back(0, 0, -1);
+    s.bisector.emplace_back(0, 0, -1);
+    s.in_view.push_back(1);
+  }
+  t.seams.push_back(s);
+  return t;
+}
+
+// Tool frame with z = -normal = +z (camera) and x along +x: the identity.
+std::vector<gt::ToolPose> line_poses(double x0, double x1, int n, const Eigen::Vector3d& offset,
+                                     const Eigen::Quaterniond& q = Eigen::Quaterniond::Identity()) {
+  std::vector<gt::ToolPose> poses;
+  for (int k = 0; k < n; ++k) {
+    gt::ToolPose p;
+    p.position = Eigen::Vector3d(x0 + (x1 - x0) * k / (n - 1), 0.0, 0.4) + offset;
+    p.orientation = q;
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+}  // namespace
+
+TEST(Eval, PerfectDetectionIsIoU100) {
+  const gt::SynthTruth t = hand_truth();
+  const gt::EvalMetrics m = gt::evaluate(t, t.label, line_poses(-0.1, 0.1, 50, {0, 0, 0}));
+  EXPECT_DOUBLE_EQ(m.iou_percent, 100.0);
+  EXPECT_DOUBLE_EQ(m.precision_percent, 100.0);
+  EXPECT_DOUBLE_EQ(m.recall_percent, 100.0);
+  EXPECT_EQ(m.truth_points, 40u);
+  EXPECT_EQ(m.valid_points, 200u);
+  EXPECT_NEAR(m.distance_mean, 0.0, 1e-12);
+  EXPECT_NEAR(m.distance_max, 0.0, 1e-12);
+  EXPECT_NEAR(m.tool_axis_max_deg, 0.0, 1e-9);
+  EXPECT_NEAR(m.travel_axis_max_deg, 0.0, 1e-9);
+  EXPECT_NEAR(m.coverage_percent, 100.0, 1e-9);
+  EXPECT_NEAR(m.seam_length_in_view, 0.2, 1e-12);
+}
+
+TEST(Eval, PartialDetections) {
+  gt::SynthTruth t = hand_truth();
+  std::vector<std::uint8_t> half(200, 0);
+  for (int i = 80; i < 100; ++i) half[i] = 1;  // 20 of the 40
+  gt::EvalMetrics m = gt::evaluate(t, half, {});
+  EXPECT_NEAR(m.iou_percent, 50.0, 1e-12);  // 20 / (20 + 40 - 20)
+  EXPECT_NEAR(m.precision_percent, 100.0, 1e-12);
+  EXPECT_NEAR(m.recall_percent, 50.0, 1e-12);
+  // 20 right and 20 wrong: 20 / (40 + 40 - 20).
+  for (int i = 0; i < 20; ++i) half[i] = 1;
+  m = gt::evaluate(t, half, {});
+  EXPECT_NEAR(m.iou_percent, 100.0 / 3.0, 1e-12);
+  // Points without a return do not count, detected or not.
+  for (int i = 0; i < 20; ++i) t.valid[i] = 0;
+  for (int i = 100; i < 110; ++i) t.valid[i] = 0;
+  m = gt::evaluate(t, half, {});
+  EXPECT_EQ(m.valid_points, 170u);
+  EXPECT_EQ(m.truth_points, 30u);
+  EXPECT_NEAR(m.iou_percent, 20.0 / 30.0 * 100.0, 1e-12);
+  // No groove anywhere: undefined, not 0 or 100.
+  const std::vector<std::uint8_t> none(200, 0);
+  t.label.assign(200, 0);
+  EXPECT_TRUE(std::isnan(gt::evaluate(t, none, {}).iou_percent));
+  EXPECT_THROW(gt::evaluate(t, std::vector<std::uint8_t>(199, 0), {}), gt::InputError);
+}
+
+TEST(Eval, LateralOffsetIsLateralError) {
+  const gt::SynthTruth t = hand_truth();
+  const gt::EvalMetrics m = gt::evaluate(t, t.label, line_poses(-0.09, 0.09, 37, {0, 0.001, 0}));
+  EXPECT_NEAR(m.lateral_mean, 0.001, 1e-6);
+  EXPECT_NEAR(m.lateral_max, 0.001, 1e-6);
+  EXPECT_NEAR(m.depth_mean, 0.0, 1e-12);
+  EXPECT_NEAR(m.depth_max, 0.0, 1e-12);
+  EXPECT_NEAR(m.distance_mean, 0.001, 1e-6);
+  EXPECT_EQ(m.waypoints, 37u);
+}
+
+TEST(Eval, DepthOffsetIsDepthError) {
+  const gt::SynthTruth t = hand_truth();
+  // 1 mm towards the camera (-z): above the root, positive along the outward normal.
+  const gt::EvalMetrics m = gt::evaluate(t, t.label, line_poses(-0.09, 0.09, 10, {0, 0, -0.001}));
+  EXPECT_NEAR(m.depth_mean, 0.001, 1e-9);
+  EXPECT_NEAR(m.depth_bias, 0.001, 1e-9);
+  EXPECT_NEAR(m.lateral_max, 0.0, 1e-12);
+  // And below it.
+  const gt::EvalMetrics b = gt::evaluate(t, t.label, line_poses(-0.09, 0.09, 10, {0, 0, 0.002}));
+  EXPECT_NEAR(b.depth_bias, -0.002, 1e-9);
+  EXPECT_NEAR(b.depth_max, 0.002, 1e-9);
+}
+
+TEST(Eval, AxisErrors) {
+  const gt::SynthTruth t = hand_truth();
+  // Torch tilted 10 deg about the travel axis.
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(10.0 * kPi / 180.0, Eigen::Vector3d::UnitX()));
+  gt::EvalMetrics m = gt::evaluate(t, t.label, line_poses(-0.1, 0.1, 20, {0, 0, 0}, tilt));
+  EXPECT_NEAR(m.tool_axis_mean_deg, 10.0, 1e-9);
+  EXPECT_NEAR(m.travel_axis_max_deg, 0.0, 1e-9);
+  // Tool yawed 5 deg about its own z: the travel axis is 5 deg off, the torch axis is not.
+  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(5.0 * kPi / 180.0, Eigen::Vector3d::UnitZ()));
+  m = gt::evaluate(t, t.label, line_poses(-0.1, 0.1, 20, {0, 0, 0}, yaw));
+  EXPECT_NEAR(m.travel_axis_mean_deg, 5.0, 1e-9);
+  EXPECT_NEAR(m.tool_axis_max_deg, 0.0, 1e-9);
+  // Travelling towards -x with the tool x still along +x: 180 deg off.
+  m = gt::evaluate(t, t.label, line_poses(0.1, -0.1, 20, {0, 0, 0}));
+  EXPECT_NEAR(m.travel_axis_mean_deg, 180.0, 1e-9);
+}
+
+TEST(Eval, CoverageOfHalfATrajectory) {
+  const gt::SynthTruth t = hand_truth();
+  // Waypoints over x in [-0.1, 0]: the root is covered up to 6 mm beyond the last one.
+  const gt::EvalMetrics m = gt::evaluate(t, t.label, line_poses(-0.1, 0.0, 26, {0, 0, 0}));
+  EXPECT_NEAR(m.coverage_percent, (0.1 + 0.006) / 0.2 * 100.0, 0.3);
+  // 7 mm to the side: nothing within 6 mm.
+  EXPECT_NEAR(gt::evaluate(t, t.label, line_poses(-0.1, 0.1, 26, {0, 0.007, 0})).coverage_percent,
+              0.0, 1e-12);
+  // Out-of-view root does not count: hide the second half.
+  gt::SynthTruth h = t;
+  for (std::size_t k = 101; k < h.seams[0].in_view.size(); ++k) h.seams[0].in_view[k] = 0;
+  EXPECT_NEAR(gt::evaluate(h, h.label, line_poses(-0.1, 0.0, 26, {0, 0, 0})).coverage_percent,
+              100.0, 1e-9);
+  // No trajectory: nothing covered, trajectory errors undefined.
+  const gt::EvalMetrics none = gt::evaluate(t, t.label, {});
+  EXPECT_DOUBLE_EQ(none.coverage_percent, 0.0);
+  EXPECT_TRUE(std::isnan(none.distance_mean));
+}
+
+TEST(Eval, ReadsARunDirectory) {
+  // A small real scan, a hand-written run output that detects exactly the truth and follows
+  // the root line, and the files eval reads.
+  gt::SynthParams p;
+  p.shape = gt::Shape::kStraight;
+  p.width = 160;
+  p.height = 120;
+  p.noise = false;
+  const gt::SynthScan scan = gt::render(p);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gt-eval-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "out");
+  const std::string scan_path = (dir / "scan.pcd").string();
+  gt::write_synth_scan(scan, scan_path);
+
+  {
+    std::ofstream pcd(dir / "out" / "annotated.pcd", std::ios::binary);
+    pcd << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z normal_x normal_y normal_z descriptor groove\n"
+           "SIZE 4 4 4 4 4 4 4 1\nTYPE F F F F F F F U\nCOUNT 1 1 1 1 1 1 1 1\n"
+        << "WIDTH " << p.width << "\nHEIGHT " << p.height << "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
+        << scan.cloud.size() << "\nDATA binary\n";
+    for (std::size_t i = 0; i < scan.cloud.size(); ++i) {
+      const float f[7] = {scan.cloud.x[i], scan.cloud.y[i], scan.cloud.z[i], 0, 0, -1, 1};
+      pcd.write(reinterpret_cast<const char*>(f), sizeof f);
+      const char g = static_cast<char>(scan.truth.label[i]);
+      pcd.write(&g, 1);
+    }
+  }
+  const gt::Seam& seam = scan.truth.seams[0];
+  {
+    std::ofstream csv(dir / "out" / "trajectory.csv");
+    csv << "idx,x_m,y_m,z_m,qx,qy,qz,qw,rx,ry,rz\n";
+    csv.precision(17);
+    for (std::size_t k = 0; k < seam.root.size(); k += 10) {
+      // Tool z = -normal, x along the seam's direction in the camera frame.
+      const Eigen::Vector3d z = -seam.normal[k];
+      const Eigen::Vector3d x = (seam.root.back() - seam.root.front()).normalized();
+      Eigen::Matrix3d R;
+      R.col(0) = (x - x.dot(z) * z).normalized();
+      R.col(2) = z;
+      R.col(1) = z.cross(R.col(0));
+      const Eigen::Quaterniond q(R);
+      const Eigen::Vector3d& r = seam.root[k];
+      csv << k / 10 << "," << r.x() << "," << r.y() << "," << r.z() << "," << q.x() << "," << q.y()
+          << "," << q.z() << "," << q.w() << ",0,0,0\n";
+    }
+  }
+  std::ofstream(dir / "out" / "report.json")
+      << R"({"timings_ms": {"features": 10.5, "total": 25.0}})";
+
+  const gt::EvalMetrics m = gt::evaluate_files(scan_path, (dir / "out").string());
+  EXPECT_DOUBLE_EQ(m.iou_percent, 100.0);
+  EXPECT_LT(m.distance_max, 1e-9);
+  EXPECT_LT(m.tool_axis_max_deg, 1e-6);
+  EXPECT_LT(m.travel_axis_max_deg, 1e-6);
+  EXPECT_GT(m.coverage_percent, 99.9);
+  EXPECT_DOUBLE_EQ(m.runtime_ms, 25.0);
+  EXPECT_NEAR(m.points_per_second, 160.0 * 120.0 / 0.025, 1e-6);
+  ASSERT_EQ(m.stage_ms.size(), 1u);
+  EXPECT_EQ(m.stage_ms[0].first, "features");
+  EXPECT_TRUE(m.notes.empty());
+
+  const std::string json = gt::metrics_json(m, scan_path, (dir / "out").string());
+  EXPECT_NE(json.find("\"iou_percent\": 100.0"), std::string::npos) << json;
+  EXPECT_NE(gt::metrics_summary(m).find("IoU 100.00 %"), std::string::npos);
+
+  // A base-frame trajectory is flagged; a missing annotated.pcd is an input error.
+  std::ofstream(dir / "out" / "trajectory.json") << R"({"frame": "base"})";
+  EXPECT_FALSE(gt::evaluate_files(scan_path, (dir / "out").string()).notes.empty());
+  EXPECT_THROW(gt::evaluate_files(scan_path, (dir / "nowhere").string()), gt::InputError);
+  std::filesystem::remove_all(dir);
+}
+
+#ifdef GT_CLI_PATH
+TEST(EvalCli, WritesMetricsAndFailsOnMissingInput) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gt-evalcli-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "out");
+  const std::string cli = GT_CLI_PATH;
+  const auto run = [](const std::string& cmd) {
+    const int status = std::system(cmd.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  ASSERT_EQ(run(cli + " synth --shape box --resolution 160x120 --noise off -o " +
+                (dir / "s.pcd").string() + " > /dev/null"),
+            0);
+  // A run output that detects nothing and has no trajectory.
+  {
+    std::ofstream pcd(dir / "out" / "annotated.pcd");
+    pcd << "VERSION 0.7\nFIELDS x y z groove\nSIZE 4 4 4 1\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+           "WIDTH 160\nHEIGHT 120\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 19200\nDATA ascii\n";
+    for (int i = 0; i < 19200; ++i) pcd << "0 0 0.4 0\n";
+  }
+  EXPECT_EQ(run(cli + " eval --truth " + (dir / "s.pcd").string() + " --result " +
+                (dir / "out").string() + " > " + (dir / "summary.txt").string()),
+            0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "metrics.json"));
+  std::ifstream summary(dir / "summary.txt");
+  const std::string text((std::istreambuf_iterator<char>(summary)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("IoU 0.00 %"), std::string::npos) << text;
+  EXPECT_NE(text.find("no trajectory.csv"), std::string::npos) << text;
+  // Missing result: exit 3; missing flag: exit 2.
+  EXPECT_EQ(run(cli + " eval --truth " + (dir / "s.pcd").string() + " --result " +
+                (dir / "none").string() + " 2> /dev/null"),
+            3);
+  EXPECT_EQ(run(cli + " eval --truth " + (dir / "s.pcd").string() + " 2> /dev/null"), 2);
+  std::filesystem::remove_all(dir);
+}
+#endif
