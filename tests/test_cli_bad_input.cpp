@@ -38,7 +38,9 @@ class BadInput : public ::testing::Test {
     EXPECT_NE(r.err.find(phrase), std::string::npos) << "stderr: " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
     EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
-    if (fs::exists(out_)) EXPECT_TRUE(fs::is_empty(out_)) << "output left behind";
+    if (fs::exists(out_)) {
+      EXPECT_TRUE(fs::is_empty(out_)) << "output left behind";
+    }
   }
   fs::path dir_, out_;
 };
