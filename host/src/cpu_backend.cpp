@@ -23,23 +23,31 @@ double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
 }
 
 // Weighted plane (and optionally quadric) fit around point i; returns the projected point.
+// The neighbourhood of the one query is kept in a per-thread scratch buffer so the quadric
+// pass does not search again (this is not a neighbour list: nothing outlives the query).
 Eigen::Vector3f mls_project(const Cloud& cloud, const NeighborGrid& grid, std::size_t i,
                             const SmoothParams& params) {
+  struct Sample {
+    Eigen::Vector3d d;
+    double w;
+  };
+  thread_local std::vector<Sample> samples;
+  samples.clear();
   const Eigen::Vector3f p = cloud.point(i);
   const double inv_h2 = 1.0 / (static_cast<double>(params.radius) * params.radius);
   // Offsets from the query point keep the sums well conditioned in float input.
   double sw = 0;
   Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
-  int count = 0;
   grid.for_each_within(p, params.radius, [&](std::uint32_t j, float d2) {
     const double w = std::exp(-d2 * inv_h2);
     const Eigen::Vector3d d = (cloud.point(j) - p).cast<double>();
     sw += w;
     s1 += w * d;
     s2 += w * d * d.transpose();
-    ++count;
+    samples.push_back({d, w});
   });
+  const int count = static_cast<int>(samples.size());
   if (count < params.min_neighbors || sw <= 0) return p;
   const Eigen::Vector3d mean = s1 / sw;
   const Eigen::Matrix3d cov = s2 / sw - mean * mean.transpose();
@@ -49,20 +57,19 @@ Eigen::Vector3f mls_project(const Cloud& cloud, const NeighborGrid& grid, std::s
   double height = q.dot(n);  // plane projection: remove the normal component entirely
   double fitted = 0.0;
   if (params.order >= 2 && count >= 6) {
-    Eigen::Vector3d u = n.unitOrthogonal();
-    Eigen::Vector3d v = n.cross(u);
+    const Eigen::Vector3d u = n.unitOrthogonal();
+    const Eigen::Vector3d v = n.cross(u);
     Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> atb = Eigen::Matrix<double, 6, 1>::Zero();
-    grid.for_each_within(p, params.radius, [&](std::uint32_t j, float d2) {
-      const double w = std::exp(-d2 * inv_h2);
-      const Eigen::Vector3d d = (cloud.point(j) - p).cast<double>() - mean;
+    for (const Sample& s : samples) {
+      const Eigen::Vector3d d = s.d - mean;
       const double a = d.dot(u), b = d.dot(v), h = d.dot(n);
       Eigen::Matrix<double, 6, 1> row;
       row << 1, a, b, a * a, a * b, b * b;
-      ata += w * row * row.transpose();
-      atb += w * h * row;
-    });
-    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(ata);
+      ata.selfadjointView<Eigen::Lower>().rankUpdate(row, s.w);
+      atb += s.w * h * row;
+    }
+    Eigen::LDLT<Eigen::Matrix<double, 6, 6>, Eigen::Lower> ldlt(ata);
     if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
       const Eigen::Matrix<double, 6, 1> c = ldlt.solve(atb);
       const double a = q.dot(u), b = q.dot(v);
