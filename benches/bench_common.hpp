@@ -5,10 +5,14 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
+#include <cmath>
 #include <groovetrace/detect.hpp>
 #include <groovetrace/features.hpp>
+#include <groovetrace/opencl.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <map>
+#include <memory>
 
 #include "../tests/scenes.hpp"
 
@@ -73,6 +77,89 @@ inline pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const Cloud& c) {
   for (std::size_t i = 0; i < c.size(); ++i) out->points[i] = {c.x[i], c.y[i], c.z[i]};
   return out;
 }
+
+// What the organized kernels walk (kernels/neighbors.cl), replayed on the host for the flop
+// counts of docs/benchmarks.md: per valid query point, the candidates tested (one per lane and
+// window position, `lanes` queries per work-item sharing the widest ellipse) and the
+// neighbours within r among them. The slack (how far points sit off their pixel rays: about 0
+// for a rendered frame, a pixel after smoothing) is the 99.99th percentile of the projection
+// residuals, as the backend estimates it, here from the frames' known intrinsics.
+struct WalkStats {
+  double candidates_per_point = 0, neighbours_per_point = 0, slack_px = 0;
+};
+inline WalkStats organized_walk(const Cloud& c, float r, int lanes) {
+  const int w = static_cast<int>(c.width), h = static_cast<int>(c.height);
+  const double f = 0.5 * w / std::tan(32.5 * M_PI / 180);  // the rendered frames' fx = fy
+  std::vector<double> residual;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!c.valid(i)) continue;
+    const double du = static_cast<double>(i % w) - (f * c.x[i] / c.z[i] + 0.5 * w);
+    const double dv = static_cast<double>(i / w) - (f * c.y[i] / c.z[i] + 0.5 * h);
+    residual.push_back(std::max(std::abs(du), std::abs(dv)));
+  }
+  auto q = residual.begin() + static_cast<std::ptrdiff_t>(0.9999 * (residual.size() - 1));
+  std::nth_element(residual.begin(), q, residual.end());
+  const float slack = static_cast<float>(*q);
+  double candidates = 0, neighbours = 0, queries = 0;
+  for (int row = 0; row < h; ++row) {
+    for (int c0 = 0; c0 < w; c0 += lanes) {
+      float rad = 0;
+      int valid = 0;
+      for (int q = c0; q < std::min(c0 + lanes, w); ++q) {
+        const std::size_t i = static_cast<std::size_t>(row) * w + q;
+        if (!c.valid(i)) continue;
+        ++valid;
+        const Eigen::Vector3f p = c.point(i);
+        rad = std::max(rad, r * p.norm() / (p.z() * (p.z() - r)));
+      }
+      if (valid == 0) continue;
+      queries += valid;
+      const float rx = static_cast<float>(f) * rad * 1.001f + 1e-3f + 2 * slack, ry = rx;
+      const int hy = static_cast<int>(std::ceil(ry));
+      for (int rr = std::max(row - hy, 0); rr <= std::min(row + hy, h - 1); ++rr) {
+        const float dv = static_cast<float>(rr - row) / ry;
+        const int hw = static_cast<int>(std::ceil(rx * std::sqrt(std::max(0.0f, 1 - dv * dv))));
+        const int t0 = std::max(-hw, -c0 - (lanes - 1)), t1 = std::min(hw, w - 1 - c0);
+        if (t0 > t1) continue;
+        candidates += static_cast<double>(t1 - t0 + 1) * lanes;
+        for (int q = c0; q < std::min(c0 + lanes, w); ++q) {
+          const std::size_t i = static_cast<std::size_t>(row) * w + q;
+          if (!c.valid(i)) continue;
+          for (int t = t0; t <= t1; ++t) {
+            const int col = q + t;
+            if (col < 0 || col >= w) continue;
+            const std::size_t j = static_cast<std::size_t>(rr) * w + col;
+            if (c.valid(j) && (c.point(j) - c.point(i)).squaredNorm() <= r * r) ++neighbours;
+          }
+        }
+      }
+    }
+  }
+  return {candidates / queries, neighbours / queries, slack};
+}
+
+// The OpenCL backend on the default device, created once (its program build is not what is
+// measured); nullptr without a device. OpenCL benchmarks call their stage once before timing:
+// PoCL compiles each kernel's work-group function on its first launch (and keeps it in its
+// disk cache, so a new process does not pay it again).
+inline FeatureBackend* opencl_backend() {
+  static std::unique_ptr<FeatureBackend> backend = [] {
+    try {
+      return make_opencl_backend();
+    } catch (const std::exception&) {
+      return std::unique_ptr<FeatureBackend>();
+    }
+  }();
+  return backend.get();
+}
+
+// Skips the benchmark (with a note in the output) when there is no OpenCL device.
+#define REQUIRE_OPENCL(var)                  \
+  FeatureBackend* var = opencl_backend();    \
+  if (var == nullptr) {                      \
+    state.SkipWithError("no OpenCL device"); \
+    return;                                  \
+  }
 
 #define STAGE(fn) \
   BENCHMARK(fn)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5)

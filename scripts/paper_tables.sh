@@ -8,7 +8,21 @@
 #       [--backend cpu|opencl|auto] [--results FILE.md] [--figures DIR]
 #
 # --quick: one seed per shape; results and pictures go under --out unless given.
+# --sweep: afterwards also the robust method's sweep (issue 4: every shape, 640x480 and
+# 1280x720, distances, tilts, unorganized and base-frame clouds; scripts/robust_sweep.sh)
+# into docs/results-robust.md, with the same --bin.
 # The work is done by scripts/paper_tables.py (Debian's /usr/bin/python3, standard library).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-exec /usr/bin/python3 scripts/paper_tables.py --invocation "scripts/paper_tables.sh${*:+ $*}" "$@"
+sweep=0
+bin=()
+args=()
+prev=""
+for a in "$@"; do
+  if [ "$a" = --sweep ]; then sweep=1; else args+=("$a"); fi
+  if [ "$prev" = --bin ]; then bin=(--bin "$a"); fi
+  prev="$a"
+done
+/usr/bin/python3 scripts/paper_tables.py --invocation "scripts/paper_tables.sh${*:+ $*}" \
+  ${args[@]+"${args[@]}"}
+if [ "$sweep" = 1 ]; then exec scripts/robust_sweep.sh ${bin[@]+"${bin[@]}"}; fi

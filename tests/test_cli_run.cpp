@@ -54,8 +54,8 @@ class CliRun : public ::testing::Test {
 
 TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend cpu",
-                               dir_);
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --method paper --backend cpu", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("outputs in"), std::string::npos) << r.out;
   for (const char* f :
@@ -115,7 +115,7 @@ TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
   const fs::path cfg = dir_ / "cfg.yaml";
   std::ofstream(cfg) << "slices: 20\nthreshold: 6.0\nweld_speed: 0.01\n";
   const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --config " +
-                                   cfg.string() + " --slices 30 --backend cpu -q",
+                                   cfg.string() + " --method paper --slices 30 --backend cpu -q",
                                dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "");  // --quiet
@@ -129,7 +129,8 @@ TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
 TEST_F(CliRun, AutoThresholdFindsTheGroove) {
   const fs::path out = dir_ / "out_auto";
   const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --threshold auto --backend cpu", dir_);
+      "run " + scan_.string() + " -o " + out.string() + " --method paper --threshold auto --backend cpu",
+      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
   EXPECT_EQ(report["detection"]["threshold_mode"], "otsu_log_descriptor");

@@ -115,10 +115,15 @@ ParamSpec path(const std::string& key, const std::string& help, std::string Para
 
 std::vector<ParamSpec> build_specs() {
   std::vector<ParamSpec> s;
-  s.push_back(choice("method", "detection method: paper (as published)", &Params::method,
-                     {"paper"}));
+  s.push_back(choice("method",
+                     "detection method: robust (docs/method-robust.md) or paper (as published)",
+                     &Params::method, {"paper", "robust"}));
   s.push_back(choice("backend", "feature backend: auto, cpu or opencl", &Params::backend,
                      {"auto", "cpu", "opencl"}));
+  s.push_back({"device", "OpenCL device: its index N or part of its name; default: first GPU, "
+                         "else first device",
+               [](Params& p, const std::string& t) { p.device = trim(t); },
+               [](const Params& p) { return quoted(p.device); }});
   s.push_back({"units", "unit of the input coordinates: m or mm",
                [](Params& p, const std::string& t) {
                  p.units_scale = one_of("units", t, {"m", "mm"}) == "mm" ? 0.001 : 1.0;
@@ -167,8 +172,17 @@ std::vector<ParamSpec> build_specs() {
                       &Params::min_component, 1, 100000000));
   s.push_back(length("link_distance", "max gap within one groove part; 0 = radius",
                      &Params::link_distance, 0.0, 0.1));
-  s.push_back(integer("slices", "slices along the groove, one waypoint each", &Params::slices,
-                      2, 100000));
+  s.push_back({"slices",
+               "slices along the groove, one waypoint each (robust: given, it wins over step)",
+               [](Params& p, const std::string& t) {
+                 p.slices = int_in_range("slices", t, 2, 100000);
+                 p.slices_given = true;
+               },
+               [](const Params& p) { return std::to_string(p.slices); }});
+  s.push_back(length("step", "robust: waypoint spacing along the seam", &Params::step, 1e-4, 0.1));
+  s.push_back(integer(
+      "max_seams", "robust: seams exported, best first (trajectory.csv, then trajectory_1.csv...)",
+      &Params::max_seams, 1, 100));
   s.push_back(integer("median_max_iterations", "geometric-median iteration cap",
                       &Params::median_max_iterations, 1, 1000000));
   s.push_back(length("median_tolerance", "geometric-median stop step", &Params::median_tolerance,

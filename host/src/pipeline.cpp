@@ -52,6 +52,57 @@ void validate(const Params& params) {
   }
 }
 
+namespace {
+
+// --method robust (docs/method-robust.md). Needs no feature backend: its normals are the
+// crease map's plane normals at the groove's scale, its descriptor the concavity (mm).
+void run_robust(const Cloud& cloud, const Params& params, RunResult& r, StageTimer& timer) {
+  RobustParams rp;
+  rp.step = params.step;
+  rp.slices = params.slices_given ? params.slices : 0;
+  rp.max_seams = params.max_seams;
+  r.smoothed = cloud;
+  r.robust = detect_robust(cloud, rp, [&](const std::string& stage) { timer.lap(stage); });
+  r.normals = r.robust.normals;
+  r.benchmark_normal = benchmark_normal(r.normals);
+  r.descriptor.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    r.descriptor[i] = r.robust.concavity[i] * 1000.0f;
+  }
+  Detection& d = r.detection;
+  d.groove = r.robust.groove;
+  d.threshold = r.robust.threshold * 1000.0;
+  d.above_threshold = r.robust.candidates;
+  d.component_label.assign(cloud.size(), -1);
+  std::vector<const SeamCandidate*> accepted;
+  for (const SeamCandidate& s : r.robust.seams) {
+    if (s.accepted) accepted.push_back(&s);
+  }
+  d.components = accepted.size();
+  if (accepted.empty()) {
+    std::string why = std::to_string(r.robust.seams.size()) + " candidate seams";
+    if (!r.robust.seams.empty()) {
+      why += ", none a V-groove (best: " + r.robust.seams.front().reason + ")";
+    }
+    throw NoGrooveError("no groove found: " + std::to_string(r.robust.candidates) +
+                        " concave candidates, " + why);
+  }
+  for (const SeamCandidate* s : accepted) {
+    d.component_sizes.push_back(s->sections.size());
+  }
+  for (std::size_t k = 0; k < accepted.size() && static_cast<int>(k) < params.max_seams; ++k) {
+    Trajectory t = seam_trajectory(*accepted[k], rp);
+    if (k == 0) {
+      r.trajectory = std::move(t);
+    } else {
+      r.extra_trajectories.push_back(std::move(t));
+    }
+  }
+  timer.lap("trajectory");
+}
+
+}  // namespace
+
 RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend& backend,
                        const StageCallback& on_stage) {
   validate(params);
@@ -71,6 +122,15 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   Cloud cloud = input;
   if (params.viewpoint) cloud.viewpoint = *params.viewpoint;
   const float radius = static_cast<float>(params.radius);
+
+  if (params.method == "robust") {
+    run_robust(cloud, params, r, timer);
+    if (T_base_camera) {
+      transform_trajectory(r.trajectory, *T_base_camera);
+      for (Trajectory& t : r.extra_trajectories) transform_trajectory(t, *T_base_camera);
+    }
+    return r;
+  }
 
   if (params.smooth) {
     SmoothParams sp;
@@ -116,6 +176,50 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   return r;
 }
 
+namespace {
+
+// report.json "robust": the candidate threshold and every candidate seam with its score
+// (docs/method-robust.md, "Score"), best first; `file` names the trajectory written for it.
+nlohmann::json robust_report(const RunResult& result, const Params& params) {
+  using nlohmann::json;
+  const RobustDetection& rd = result.robust;
+  json seams = json::array();
+  int exported = 0;
+  for (std::size_t k = 0; k < rd.seams.size(); ++k) {
+    const SeamCandidate& s = rd.seams[k];
+    json file = nullptr;
+    if (s.accepted && exported < params.max_seams) {
+      file = exported == 0 ? "trajectory.csv" : "trajectory_" + std::to_string(exported) + ".csv";
+      ++exported;
+    }
+    auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    seams.push_back({{"rank", k},
+                     {"accepted", s.accepted},
+                     {"reason", s.reason},
+                     {"score", num(s.score)},
+                     {"length_m", num(s.length)},
+                     {"closed", s.closed},
+                     {"corners", s.curve.corners.size()},
+                     {"sections", s.sections.size()},
+                     {"ok_fraction", num(s.ok_fraction)},
+                     {"fit_quality", num(s.fit_quality)},
+                     {"consistency", num(s.consistency)},
+                     {"width_m", num(s.width)},
+                     {"depth_m", num(s.depth)},
+                     {"opening_deg", num(s.opening_deg)},
+                     {"file", file}});
+  }
+  return {{"concavity_threshold_m", rd.threshold},
+          {"concavity_sigma_m", rd.noise_sigma},
+          {"candidate_voxels", rd.candidates},
+          {"crease_nodes", rd.nodes},
+          {"confirmed_nodes", rd.confirmed_nodes},
+          {"score", "length_mm * ok_fraction * fit_quality * consistency"},
+          {"seams", seams}};
+}
+
+}  // namespace
+
 std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& input,
                                                                 const RunResult& result,
                                                                 const Params& params,
@@ -131,6 +235,13 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
   files.emplace_back("trajectory.csv", trajectory_csv(result.trajectory));
   files.emplace_back("trajectory.json", trajectory_json(result.trajectory, params));
   files.emplace_back("program.script", urscript_program(result.trajectory, params));
+  for (std::size_t k = 0; k < result.extra_trajectories.size(); ++k) {
+    const std::string n = std::to_string(k + 1);
+    const Trajectory& t = result.extra_trajectories[k];
+    files.emplace_back("trajectory_" + n + ".csv", trajectory_csv(t));
+    files.emplace_back("trajectory_" + n + ".json", trajectory_json(t, params));
+    files.emplace_back("program_" + n + ".script", urscript_program(t, params));
+  }
 
   std::size_t with_normal = 0, groove = 0;
   for (std::size_t i = 0; i < result.normals.size(); ++i) {
@@ -157,8 +268,11 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
         {"above_threshold", result.detection.above_threshold},
         {"groove", groove}}},
       {"detection",
-       {{"threshold_deg2", result.detection.threshold},
-        {"threshold_mode", params.threshold_auto ? "otsu_log_descriptor" : "fixed"},
+       {{"threshold_deg2", params.method == "robust" ? json(nullptr)
+                                                      : json(result.detection.threshold)},
+        {"threshold_mode", params.method == "robust" ? "robust_concavity_mm"
+                           : params.threshold_auto  ? "otsu_log_descriptor"
+                                                    : "fixed"},
         {"components", result.detection.components},
         {"component_sizes", result.detection.component_sizes},
         {"benchmark_normal", {ub.x(), ub.y(), ub.z()}}}},
@@ -168,6 +282,7 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
         {"length_m", result.trajectory.length}}},
       {"timings_ms", timings},
       {"warnings", result.warnings}};
+  if (params.method == "robust") report["robust"] = robust_report(result, params);
   files.emplace_back("report.json", report.dump(2) + "\n");
   return files;
 }

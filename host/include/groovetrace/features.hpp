@@ -17,6 +17,13 @@ struct SmoothParams {
   int min_neighbors = 5;  ///< fewer neighbours: the point is kept unchanged
 };
 
+/// Normals, benchmark normal and descriptor of one cloud, from one call.
+struct FeatureSet {
+  Normals normals;                   ///< oriented to the viewpoint (cloud frame)
+  Eigen::Vector3f benchmark_normal;  ///< u_b (unit; NaN when no point has a normal)
+  std::vector<float> descriptor;     ///< D (deg^2), NaN where undefined
+};
+
 /// Per-point work of the pipeline. Every method keeps input order and size; invalid (NaN)
 /// points stay invalid. Neighbours are the valid points within `radius` (m) in 3-D.
 class FeatureBackend {
@@ -26,6 +33,9 @@ class FeatureBackend {
   virtual std::string name() const = 0;
   /// Human-readable device, e.g. "OpenMP, 2 threads" or the OpenCL device name.
   virtual std::string device() const = 0;
+  /// Why this backend stands in for the one asked for (e.g. "auto" found no OpenCL device);
+  /// empty otherwise. Callers show it to the user.
+  virtual std::string warning() const { return {}; }
 
   /// MLS-smoothed copy of `cloud` (same frame, metres).
   virtual Cloud smooth(const Cloud& cloud, const SmoothParams& params) = 0;
@@ -42,15 +52,24 @@ class FeatureBackend {
   /// without a normal, or with no neighbour that has one, get NaN.
   virtual std::vector<float> descriptor(const Cloud& cloud, const Normals& normals, float radius,
                                         const Eigen::Vector3f& u_b) = 0;
+
+  /// normals(), benchmark_normal() and descriptor() with the same radius, in one call: a
+  /// device backend keeps the cloud, its search structure and the normals on the device
+  /// between the three. Same results as the separate calls.
+  virtual FeatureSet features(const Cloud& cloud, float radius, int min_neighbors);
 };
 
 /// The benchmark normal u_b = normalize(sum of all valid normals) (paper eq. 4).
 /// Returns NaN if the normals sum to zero.
 Eigen::Vector3f benchmark_normal(const Normals& normals);
 
-/// Creates a backend by name: "cpu", "opencl" or "auto" (opencl when available, else cpu).
-/// Throws UsageError for an unknown name.
-std::unique_ptr<FeatureBackend> make_backend(const std::string& name);
+/// Creates a backend by name: "cpu", "opencl" or "auto" (opencl when a device is present and
+/// the kernels build on it, else cpu with a warning() saying why). `device` picks the OpenCL
+/// device: an index into list_opencl_devices() or a name substring (see opencl.hpp); empty =
+/// the first GPU, else the first device. Throws UsageError for an unknown name or a device
+/// that matches nothing, OpenClError (an InternalError) when "opencl" cannot run.
+std::unique_ptr<FeatureBackend> make_backend(const std::string& name,
+                                             const std::string& device = "");
 
 /// The CPU reference backend (OpenMP + Eigen).
 std::unique_ptr<FeatureBackend> make_cpu_backend();

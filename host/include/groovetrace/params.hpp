@@ -10,8 +10,9 @@ namespace groovetrace {
 /// Parameters of the pipeline. Lengths in metres, speeds in m/s, angles in degrees.
 struct Params {
   // Method and backend.
-  std::string method = "paper";  ///< "paper" (as published) or "robust" (planned)
+  std::string method = "robust";  ///< "robust" (docs/method-robust.md) or "paper" (as published)
   std::string backend = "auto";  ///< "auto", "cpu" or "opencl"
+  std::string device;            ///< OpenCL device: index or name part; empty = first GPU, else first
   double units_scale = 1.0;      ///< input coordinates * units_scale = metres (mm: 0.001)
 
   // Features.
@@ -30,6 +31,9 @@ struct Params {
 
   // Trajectory.
   int slices = 50;               ///< equal-width slices along the groove = waypoints
+  bool slices_given = false;     ///< slices was set (flag or config): robust uses it over step
+  double step = 0.002;           ///< robust: waypoint spacing along the seam (m)
+  int max_seams = 1;             ///< robust: seams exported as trajectories, best first
   int median_max_iterations = 1000;
   double median_tolerance = 1e-7;  ///< Weiszfeld stop: step below this (m), the paper's 1e-4 mm
 

@@ -5,6 +5,7 @@
 #include <groovetrace/detect.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/params.hpp>
+#include <groovetrace/robust.hpp>
 #include <groovetrace/trajectory.hpp>
 
 #include <functional>
@@ -22,6 +23,11 @@ struct RunResult {
   std::vector<float> descriptor;   ///< D (deg^2)
   Detection detection;
   Trajectory trajectory;           ///< camera frame, or base frame when frames were given
+  /// --method robust: the seams after the best, up to max_seams - 1, same frame as trajectory
+  /// (written as trajectory_1.csv, ...).
+  std::vector<Trajectory> extra_trajectories;
+  /// --method robust: candidates, seams and scores (descriptor then holds the concavity, mm).
+  RobustDetection robust;
   std::vector<std::pair<std::string, double>> timings_ms;  ///< per stage, in order
   std::vector<std::string> warnings;
   std::string backend, device;
@@ -39,7 +45,8 @@ RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend&
 void validate(const Params& params);
 
 /// The output files of a run, as bytes, keyed by file name (annotated.pcd, trajectory.csv,
-/// trajectory.json, program.script, report.json).
+/// trajectory.json, program.script, report.json; with --max-seams N > 1 also
+/// trajectory_K.csv, trajectory_K.json and program_K.script for the K-th next seam).
 std::vector<std::pair<std::string, std::string>> render_outputs(
     const Cloud& input, const RunResult& result, const Params& params,
     const std::string& input_path, double total_ms);

@@ -1,0 +1,223 @@
+#pragma once
+// The robust method (`--method robust`, docs/method-robust.md): concave-crease candidates at
+// the groove's own scale, seams traced as ordered curves, a V model fitted across the seam at
+// every station, waypoints on the fitted root, and the groove region labelled from the fitted
+// openings. Works on organized and unorganized clouds in any frame: the only use of the
+// sensor is the viewpoint (rays from it through each point).
+//
+// Frames and units: every 3-D quantity is in the cloud's frame, metres; angles in degrees.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <groovetrace/cloud.hpp>
+#include <groovetrace/trajectory.hpp>
+#include <string>
+#include <vector>
+
+namespace groovetrace {
+
+/// Settings of the robust method. The defaults are the one configuration used on every shape,
+/// distance, tilt and resolution; only `step`, `slices` and `max_seams` are run parameters.
+struct RobustParams {
+  /// Radius of the concavity measure and half-width of a cross-section's window (m). Grooves
+  /// of a top width from about 0.3 to 1.6 times this are found (default: 4-16 mm).
+  double scale = 0.010;
+  double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
+  double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
+  double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
+  double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
+  double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
+  double min_length = 0.015;  ///< seams shorter than this are rejected (m)
+  double step = 0.002;        ///< waypoint spacing along the seam (m)
+  int slices = 0;             ///< > 0: this many equal arc-length parts instead of `step`
+  int max_seams = 1;          ///< seams exported as trajectories, best first
+};
+
+// --- Stage 1: candidates ------------------------------------------------------------------
+
+/// The cloud on voxels of `cell`, with the concavity of every voxel at radius `scale`.
+struct CreaseMap {
+  std::vector<Eigen::Vector3f> points;   ///< voxel centroids (m)
+  std::vector<Eigen::Vector3f> normals;  ///< plane normal at `scale`, towards the viewpoint
+  std::vector<float> concavity;          ///< m below the weighted plane fit (> 0: concave)
+  std::vector<std::int32_t> voxel;       ///< per input point: its voxel, -1 if invalid
+  double median = 0.0;                   ///< of concavity over voxels (m)
+  double sigma = 0.0;                    ///< 1.4826 * MAD of concavity (m)
+  double threshold = 0.0;                ///< candidate threshold (m)
+};
+
+/// Voxelizes `cloud` and measures, per voxel, the height of its centroid below the weighted
+/// least-squares plane of the voxels within `params.scale`. The threshold is scale-free:
+/// median + threshold_k * 1.4826 MAD of the measure over the whole cloud.
+CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
+
+/// Crease nodes: candidate voxels that are the deepest across the seam (non-maximum
+/// suppression in a slab across the local seam direction).
+struct CreaseNodes {
+  std::vector<std::int32_t> voxel;       ///< index into CreaseMap::points
+  std::vector<Eigen::Vector3d> tangent;  ///< unit seam direction from the candidates' spread
+};
+CreaseNodes crease_nodes(const CreaseMap& map, const RobustParams& params);
+
+// --- Stage 2: cross-section fit -----------------------------------------------------------
+
+/// A V fitted to a 2-D profile: u across the seam, v along the surface normal (out of the
+/// workpiece), both in metres in the section's frame. Left is u < root.
+struct VProfile {
+  bool ok = false;
+  std::string why;                    ///< why not ok
+  Eigen::Vector2d root{0, 0};         ///< intersection of the two wall lines
+  Eigen::Vector2d edge_left{0, 0};    ///< left wall meets the top surface
+  Eigen::Vector2d edge_right{0, 0};   ///< right wall meets the top surface
+  Eigen::Vector2d bisector{0, 1};     ///< unit bisector of the walls, out of the groove
+  Eigen::Vector3d top{0, 0, 0};       ///< top surface v = top[0] + top[1] u + top[2] u^2
+  double wall_left_deg = 0.0;         ///< left wall's inclination to the top surface at its edge
+  double wall_right_deg = 0.0;        ///< same, right
+  double opening_deg = 0.0;           ///< included angle between the walls
+  double width = 0.0;                 ///< |edge_right - edge_left| (m)
+  double depth = 0.0;                 ///< root below the top surface (m)
+  double noise = 0.0;                 ///< robust sigma of the top's residuals (m)
+  double rms = 0.0;                   ///< rms of the wall residuals (m)
+  int top_left = 0, top_right = 0;    ///< top-surface points left and right of the groove
+  int wall_left = 0, wall_right = 0;  ///< points that fitted each wall
+  /// One wall returned (almost) nothing (seen at a grazing angle): that wall's edge is where the
+  /// top surface ends, the V taken symmetric about the top normal through the opening.
+  bool one_wall = false;
+};
+
+/// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
+/// quadratic (so pipes work), the points clearly below it as two walls (robust orthogonal line
+/// fits, iterated with their intersection), edges where walls meet the top. `ok` only when the
+/// profile is a V: both walls inclined into the material, both top sides present, depth above
+/// the noise. Rims and root, which sensors round off, do not enter the wall fits.
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window);
+
+/// A fitted cross-section in 3-D.
+struct GrooveSection {
+  bool ok = false;
+  std::string why;
+  double s = 0.0;                      ///< arc length of the station along the seam (m)
+  Eigen::Vector3d root{0, 0, 0};       ///< wall intersection (m)
+  Eigen::Vector3d tangent{1, 0, 0};    ///< unit, along the seam
+  Eigen::Vector3d normal{0, 0, 1};     ///< unit, top surface normal, out of the workpiece
+  Eigen::Vector3d bisector{0, 0, 1};   ///< unit wall bisector, out of the groove
+  Eigen::Vector3d edge_left{0, 0, 0};  ///< top edges (m); left = -across side
+  Eigen::Vector3d edge_right{0, 0, 0};
+  double width = 0, depth = 0, opening_deg = 0, rms = 0, noise = 0;
+  int support = 0;        ///< profile points in the slab
+  bool one_wall = false;  ///< see VProfile::one_wall
+  /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
+  /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
+  bool inferred = false;
+  /// across = normal x tangent: u grows towards edge_right.
+  Eigen::Vector3d across() const { return normal.cross(tangent).normalized(); }
+};
+
+/// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
+/// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)
+/// of origin across it. `normal_hint` orients the profile (towards the viewpoint).
+GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
+                          const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
+                          const Eigen::Vector3d& normal_hint, double slab, double half_window);
+
+/// Where the walls return nothing (seen at a grazing angle) a groove still shows as a gap in
+/// the top surface. Fits that instead of a V: both sides carry top surface, the gap nearest
+/// the centre holds no point and is 0.6-1.6 times `width` (m) wide. The section has
+/// `inferred` set, `ok` false, the root `depth` (m) below the gap's centre, edges at the
+/// gap's centre +- width / 2, bisector = top normal.
+GrooveSection fit_gap_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
+                              const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
+                              const Eigen::Vector3d& normal_hint, double slab, double half_window,
+                              double width, double depth);
+
+// --- Stage 3: seams as ordered curves -----------------------------------------------------
+
+/// One ordered chain of nodes.
+struct NodePath {
+  std::vector<int> nodes;  ///< indices into the input, in order along the seam
+  bool closed = false;     ///< the ends meet: a ring
+};
+
+/// Orders scattered seam nodes into curves: nodes within `link` (m) are joined when the link
+/// runs roughly along a node's tangent; the minimum spanning tree of each connected part is
+/// walked along its longest path (the tree's diameter), so L-corners and S-curves come out in
+/// order; the nodes near a path are then removed and the rest searched again for further
+/// seams (branches). Paths with fewer than `min_nodes` nodes are dropped. A path whose ends
+/// are within `link` of each other and which is long against `link` is closed.
+std::vector<NodePath> order_nodes(const std::vector<Eigen::Vector3d>& points,
+                                  const std::vector<Eigen::Vector3d>& tangents, double link,
+                                  std::size_t min_nodes);
+
+/// A seam's centre line, resampled at a fixed arc-length spacing.
+struct SeamCurve {
+  std::vector<Eigen::Vector3d> points;    ///< m
+  std::vector<Eigen::Vector3d> tangents;  ///< unit, in the order of the points
+  std::vector<double> s;                  ///< arc length at each point (m)
+  std::vector<double> corners;            ///< arc length of each sharp corner (m)
+  bool closed = false;
+  double length = 0.0;  ///< m (closed: the whole ring)
+};
+
+/// Smooths an ordered polyline by local quadratic fits over 3 `half_window` (m) of arc length,
+/// keeping sharp corners as corners, and resamples it every `spacing` (m). A corner is a turn
+/// of over 45 degrees between the chords 3 half_window before and after a point, measured in
+/// the surface (the plane normal to `normals`, one per point, when given: depth noise of the
+/// roots must not look like a corner), kept at its maximum within 6 half_window.
+SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed, double half_window,
+                       double spacing, const std::vector<Eigen::Vector3d>& normals = {});
+
+// --- Stage 4: seam candidates, scores, region ---------------------------------------------
+
+/// One candidate seam with its sections and score (docs/method-robust.md, "Score").
+struct SeamCandidate {
+  std::vector<GrooveSection> sections;  ///< along the seam, smoothed (`ok`: its own fit passed)
+  std::vector<GrooveSection> raw;       ///< the same stations' own fits, before smoothing
+  SeamCurve curve;                      ///< the smoothed root line
+  bool closed = false;
+  double length = 0.0;       ///< m
+  double ok_fraction = 0.0;  ///< sections whose V fit passed
+  double fit_quality = 0.0;  ///< median over sections of depth / (depth + 3 rms)
+  double consistency = 0.0;  ///< 1 - relative spread of width and opening along the seam
+  double width = 0, depth = 0, opening_deg = 0;  ///< medians (m, m, deg)
+  double score = 0.0;  ///< length_mm * ok_fraction * fit_quality * consistency
+  bool accepted = false;
+  std::string reason;  ///< why rejected (empty when accepted)
+};
+
+/// Scores a candidate and decides whether it is a V-groove seam (fills score, accepted,
+/// reason and the medians).
+void score_seam(SeamCandidate& seam, const RobustParams& params);
+
+/// Labels groove points: a point is groove when its viewing ray (from cloud.viewpoint) passes
+/// through the opening of an accepted seam (between the two fitted top edges of the nearest
+/// sections) and the point lies at or below that opening. Returns 1/0 per point.
+std::vector<std::uint8_t> label_grooves(const Cloud& cloud,
+                                        const std::vector<SeamCandidate>& seams);
+
+/// Torch poses along a seam: positions on the smoothed root line every `step` (or in
+/// `slices` equal parts), tool z = -wall bisector, tool x along the seam; rotation vectors
+/// continuous. A closed seam ends where it started. Travel runs so that the end lies at
+/// larger x of the cloud's frame than the start (ties: y).
+Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
+
+/// Everything the robust method decided.
+struct RobustDetection {
+  std::vector<std::uint8_t> groove;  ///< per input point: 1 = groove
+  std::vector<float> concavity;      ///< per input point: its voxel's concavity (m), NaN
+  Normals normals;                   ///< per input point: its voxel's plane normal at `scale`
+  double threshold = 0.0;            ///< candidate concavity threshold (m)
+  double noise_sigma = 0.0;          ///< robust sigma of the concavity (m)
+  std::size_t candidates = 0;        ///< voxels above the threshold
+  std::size_t nodes = 0;             ///< crease nodes after non-maximum suppression
+  std::size_t confirmed_nodes = 0;   ///< nodes whose cross-section is a V
+  std::vector<SeamCandidate> seams;  ///< every candidate, best score first
+};
+
+/// Runs stages 1-4 on `cloud` (metres; viewpoint = the sensor origin in its frame). Never
+/// throws for "no groove": the caller checks whether any seam is accepted. `lap`, when given,
+/// is called after each stage with its name ("candidates", "seams", "region").
+RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
+                              const std::function<void(const std::string&)>& lap = {});
+
+}  // namespace groovetrace

@@ -1,0 +1,103 @@
+// Torch poses along a traced seam: on the fitted root line, spaced by arc length, the torch
+// along the walls' bisector. The sections are already smoothed along the seam, so this only
+// interpolates between them.
+
+#include <algorithm>
+#include <cmath>
+#include <groovetrace/error.hpp>
+#include <groovetrace/robust.hpp>
+
+namespace groovetrace {
+
+Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params) {
+  std::vector<GrooveSection> secs = seam.sections;
+  if (secs.size() < 2) throw NoGrooveError("seam has fewer than 2 sections: no trajectory");
+  const bool closed = seam.closed;
+
+  // Travel direction: open seams end at larger x than they start (ties: y, then z); rings
+  // start at their smallest x and run counter-clockwise about the mean surface normal.
+  if (closed) {
+    std::size_t first = 0;
+    for (std::size_t k = 1; k < secs.size(); ++k) {
+      const Eigen::Vector3d& a = secs[k].root;
+      const Eigen::Vector3d& b = secs[first].root;
+      if (a.x() < b.x() || (a.x() == b.x() && a.y() < b.y())) first = k;
+    }
+    std::rotate(secs.begin(), secs.begin() + static_cast<std::ptrdiff_t>(first), secs.end());
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
+    for (const auto& s : secs) {
+      centre += s.root;
+      up += s.normal;
+    }
+    centre /= static_cast<double>(secs.size());
+    Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < secs.size(); ++k) {
+      turn += (secs[k].root - centre).cross(secs[(k + 1) % secs.size()].root - centre);
+    }
+    if (turn.dot(up) < 0) std::reverse(secs.begin() + 1, secs.end());
+  } else {
+    const Eigen::Vector3d d = secs.back().root - secs.front().root;
+    const double eps = 1e-9;
+    const bool backwards =
+        d.x() < -eps ||
+        (std::abs(d.x()) <= eps && (d.y() < -eps || (std::abs(d.y()) <= eps && d.z() < 0)));
+    if (backwards) std::reverse(secs.begin(), secs.end());
+  }
+
+  // Polyline through the roots (closed: back to the start), its arc length.
+  std::vector<Eigen::Vector3d> P, B;
+  for (const auto& s : secs) {
+    P.push_back(s.root);
+    B.push_back(s.bisector);
+  }
+  if (closed) {
+    P.push_back(P.front());
+    B.push_back(B.front());
+  }
+  std::vector<double> S(P.size(), 0.0);
+  for (std::size_t k = 1; k < P.size(); ++k) S[k] = S[k - 1] + (P[k] - P[k - 1]).norm();
+  const double length = S.back();
+  if (!(length > 0)) throw NoGrooveError("seam has zero length: no trajectory");
+
+  // Waypoints: `slices` of them evenly (a closed seam repeats its first at the end), else one
+  // every `step` with both ends included.
+  int intervals = 0;
+  if (params.slices > 0) {
+    intervals = closed ? params.slices : std::max(1, params.slices - 1);
+  } else {
+    intervals = std::max(1, static_cast<int>(std::ceil(length / params.step - 1e-9)));
+  }
+  Trajectory traj;
+  traj.length = length;
+  const Eigen::Vector3d chord = P.back() - P.front();
+  traj.direction = chord.norm() > 1e-9 ? Eigen::Vector3d(chord.normalized())
+                                       : Eigen::Vector3d((P[1] - P[0]).normalized());
+  std::size_t seg = 0;
+  for (int k = 0; k <= intervals; ++k) {
+    const double s0 = length * k / intervals;
+    while (seg + 2 < P.size() && S[seg + 1] < s0) ++seg;
+    const double span = S[seg + 1] - S[seg];
+    const double f = span > 0 ? std::clamp((s0 - S[seg]) / span, 0.0, 1.0) : 0.0;
+    Waypoint w;
+    w.rotation_vector.setZero();
+    w.euler_zyx_deg.setZero();
+    w.position = P[seg] + f * (P[seg + 1] - P[seg]);
+    Eigen::Vector3d bis = ((1 - f) * B[seg] + f * B[seg + 1]);
+    if (!(bis.norm() > 1e-9)) bis = B[seg];
+    // Travel along the root line here: the chord over one section spacing each way.
+    const Eigen::Vector3d before = P[seg], after = P[seg + 1];
+    Eigen::Vector3d travel = after - before;
+    if (!(travel.norm() > 1e-12)) travel = traj.direction;
+    w.orientation = tool_orientation(bis.normalized(), travel.normalized());
+    w.support = 0;
+    traj.waypoints.push_back(w);
+  }
+  if (closed && params.slices > 0) {
+    // `slices` waypoints around a ring, the last returning to the first.
+    traj.waypoints.back() = traj.waypoints.front();
+  }
+  fill_rotation_representations(traj);
+  return traj;
+}
+
+}  // namespace groovetrace

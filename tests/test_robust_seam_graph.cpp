@@ -1,0 +1,135 @@
+// Seams as ordered curves (robust_seam_graph.cpp): order along the seam's own curve, rings
+// closed, L-corners kept, parallel seams apart.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <groovetrace/robust.hpp>
+#include <random>
+
+namespace groovetrace {
+namespace {
+
+struct Nodes {
+  std::vector<Eigen::Vector3d> points, tangents;
+  std::vector<double> arc;  // true arc length of each node
+};
+
+// Nodes every ~1 mm along a polyline (m), shuffled, with lateral jitter.
+Nodes sample(const std::vector<Eigen::Vector3d>& poly, bool closed, double jitter, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, jitter);
+  Nodes n;
+  double s0 = 0;
+  const std::size_t m = poly.size();
+  for (std::size_t k = 0; k + 1 < m + (closed ? 1 : 0); ++k) {
+    const Eigen::Vector3d a = poly[k], b = poly[(k + 1) % m];
+    const double len = (b - a).norm();
+    const Eigen::Vector3d t = (b - a) / len;
+    for (double s = 0; s < len; s += 0.001) {
+      n.points.push_back(a + s * t + Eigen::Vector3d(gauss(rng), gauss(rng), 0));
+      n.tangents.push_back(t);
+      n.arc.push_back(s0 + s);
+    }
+    s0 += len;
+  }
+  std::vector<std::size_t> order(n.points.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::shuffle(order.begin(), order.end(), rng);
+  Nodes out;
+  for (std::size_t k : order) {
+    out.points.push_back(n.points[k]);
+    out.tangents.push_back(n.tangents[k]);
+    out.arc.push_back(n.arc[k]);
+  }
+  return out;
+}
+
+TEST(RobustSeamGraph, LCornerComesOutInOrder) {
+  const Nodes n = sample({{-0.06, 0, 0}, {0.03, 0, 0}, {0.03, 0.08, 0}}, false, 0.0002, 1);
+  const auto paths = order_nodes(n.points, n.tangents, 0.015, 5);
+  ASSERT_EQ(paths.size(), 1u);
+  const NodePath& p = paths[0];
+  EXPECT_FALSE(p.closed);
+  EXPECT_GT(p.nodes.size(), 0.9 * n.points.size());
+  // Monotonic in the true arc length (either way), no back-and-forth beyond the jitter.
+  const double sign = n.arc[p.nodes.back()] > n.arc[p.nodes.front()] ? 1.0 : -1.0;
+  int reversals = 0;
+  for (std::size_t k = 1; k < p.nodes.size(); ++k) {
+    if (sign * (n.arc[p.nodes[k]] - n.arc[p.nodes[k - 1]]) < -0.002) ++reversals;
+  }
+  EXPECT_EQ(reversals, 0);
+
+  // The smoothed curve keeps the corner where the legs meet.
+  std::vector<Eigen::Vector3d> ordered;
+  for (int v : p.nodes) ordered.push_back(n.points[v]);
+  const SeamCurve c = smooth_curve(ordered, false, 0.006, 0.0015);
+  ASSERT_EQ(c.corners.size(), 1u);
+  EXPECT_NEAR(c.length, 0.17, 0.004);
+  double nearest = INFINITY;
+  for (const auto& q : c.points)
+    nearest = std::min(nearest, (q - Eigen::Vector3d(0.03, 0, 0)).norm());
+  EXPECT_LT(nearest, 0.001);
+}
+
+TEST(RobustSeamGraph, RingIsClosed) {
+  std::vector<Eigen::Vector3d> circle;
+  for (int k = 0; k < 120; ++k) {
+    const double a = 2 * M_PI * k / 120;
+    circle.emplace_back(0.04 * std::cos(a), 0.04 * std::sin(a), 0);
+  }
+  const Nodes n = sample(circle, true, 0.0002, 2);
+  const auto paths = order_nodes(n.points, n.tangents, 0.015, 5);
+  ASSERT_EQ(paths.size(), 1u);
+  EXPECT_TRUE(paths[0].closed);
+  std::vector<Eigen::Vector3d> ordered;
+  for (int v : paths[0].nodes) ordered.push_back(n.points[v]);
+  const SeamCurve c = smooth_curve(ordered, true, 0.006, 0.0015);
+  EXPECT_TRUE(c.closed);
+  EXPECT_TRUE(c.corners.empty());
+  EXPECT_NEAR(c.length, 2 * M_PI * 0.04, 0.003);
+  for (const auto& q : c.points) EXPECT_NEAR(std::hypot(q.x(), q.y()), 0.04, 3e-4);
+}
+
+TEST(RobustSeamGraph, ParallelSeamsStayApartAndOpenSeamsOpen) {
+  Nodes a = sample({{-0.1, -0.01, 0}, {0.1, -0.01, 0}}, false, 0.0002, 3);
+  const Nodes b = sample({{-0.1, 0.01, 0}, {0.1, 0.01, 0}}, false, 0.0002, 4);
+  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
+  a.tangents.insert(a.tangents.end(), b.tangents.begin(), b.tangents.end());
+  // 20 mm apart, a link of 15 mm reaches across: only along-seam links may join.
+  const auto paths = order_nodes(a.points, a.tangents, 0.015, 5);
+  ASSERT_EQ(paths.size(), 2u);
+  for (const auto& p : paths) {
+    EXPECT_FALSE(p.closed);
+    double y = 0;
+    for (int v : p.nodes) y += a.points[v].y();
+    y /= static_cast<double>(p.nodes.size());
+    for (int v : p.nodes) EXPECT_NEAR(a.points[v].y(), y, 0.002);
+  }
+}
+
+TEST(RobustSeamGraph, SCurveIsSmoothWithoutCorners) {
+  // Two tangent 60 mm arcs turning 60 deg each way.
+  std::vector<Eigen::Vector3d> s;
+  for (int k = 0; k <= 60; ++k) {
+    const double a = M_PI / 3 * k / 60;
+    s.emplace_back(0.06 * std::sin(a), 0.06 * (1 - std::cos(a)), 0);
+  }
+  const Eigen::Vector3d mid = s.back();
+  for (int k = 1; k <= 60; ++k) {
+    const double a = M_PI / 3 * k / 60;
+    const Eigen::Vector3d off(0.06 * std::sin(a), -0.06 * (1 - std::cos(a)), 0);
+    s.push_back(mid + Eigen::AngleAxisd(M_PI / 3, Eigen::Vector3d::UnitZ()) * off);
+  }
+  const Nodes n = sample(s, false, 0.0002, 5);
+  const auto paths = order_nodes(n.points, n.tangents, 0.015, 5);
+  ASSERT_EQ(paths.size(), 1u);
+  std::vector<Eigen::Vector3d> ordered;
+  for (int v : paths[0].nodes) ordered.push_back(n.points[v]);
+  const SeamCurve c = smooth_curve(ordered, false, 0.006, 0.0015);
+  EXPECT_TRUE(c.corners.empty());
+  EXPECT_NEAR(c.length, 2 * 0.06 * M_PI / 3, 0.004);
+}
+
+}  // namespace
+}  // namespace groovetrace

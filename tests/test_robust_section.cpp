@@ -1,0 +1,160 @@
+// The V model fitted across a seam (robust_section.cpp): root estimation against analytic V
+// profiles, and the shapes that are not V-grooves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <groovetrace/robust.hpp>
+#include <random>
+
+namespace groovetrace {
+namespace {
+
+// Profile samples (u across, v up; m) of a V whose walls dip `left_deg` / `right_deg` below a
+// flat top at v = 0, root at (root_u, -depth), every `pitch` m in u over +-20 mm, `rows`
+// times, with Gaussian noise in v.
+std::vector<Eigen::Vector2d> v_profile(double depth, double left_deg, double right_deg,
+                                       double root_u, double noise, unsigned seed,
+                                       double pitch = 0.0008, int rows = 4) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double ul = root_u - depth / std::tan(left_deg * M_PI / 180);
+  const double ur = root_u + depth / std::tan(right_deg * M_PI / 180);
+  std::vector<Eigen::Vector2d> pts;
+  for (int r = 0; r < rows; ++r) {
+    for (double u = -0.02 + 0.25 * r * pitch; u <= 0.02; u += pitch) {
+      double v = 0.0;
+      if (u > ul && u <= root_u) v = -depth * (u - ul) / (root_u - ul);
+      if (u > root_u && u < ur) v = -depth * (ur - u) / (ur - root_u);
+      pts.emplace_back(u, v + noise * gauss(rng));
+    }
+  }
+  return pts;
+}
+
+TEST(RobustSection, RootOfANoiseFreeVIsTheWallsIntersection) {
+  const VProfile f = fit_v_profile(v_profile(0.008, 60, 60, 0.0, 0.0, 1), 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_NEAR(f.root.x(), 0.0, 1e-5);
+  EXPECT_NEAR(f.root.y(), -0.008, 1e-5);
+  const double half = 0.008 / std::tan(M_PI / 3);
+  EXPECT_NEAR(f.edge_left.x(), -half, 1e-5);
+  EXPECT_NEAR(f.edge_right.x(), half, 1e-5);
+  EXPECT_NEAR(f.opening_deg, 60.0, 0.1);
+  EXPECT_NEAR(f.depth, 0.008, 1e-5);
+  EXPECT_NEAR(f.bisector.y(), 1.0, 1e-6);  // symmetric: straight up, out of the groove
+  EXPECT_FALSE(f.one_wall);
+}
+
+TEST(RobustSection, NoisyRootStaysOnTheAnalyticRoot) {
+  // D415-like noise at 0.5 m (0.5 mm rms) over several seeds: the root stays within a few
+  // tenths of a millimetre, the opening within a few degrees.
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const VProfile f = fit_v_profile(v_profile(0.008, 60, 60, 0.001, 0.0005, seed), 0.02);
+    ASSERT_TRUE(f.ok) << f.why << " seed " << seed;
+    EXPECT_NEAR(f.root.x(), 0.001, 3e-4) << seed;
+    EXPECT_NEAR(f.root.y(), -0.008, 6e-4) << seed;
+    EXPECT_NEAR(f.opening_deg, 60.0, 6.0) << seed;
+    EXPECT_NEAR(f.width, 2 * 0.008 / std::tan(M_PI / 3), 8e-4) << seed;
+  }
+}
+
+TEST(RobustSection, AsymmetricVHasItsOwnBisector) {
+  // A V with walls at 45 and 75 deg: the bisector of the wall directions leans towards the
+  // gentler (left) wall by half the difference, (75 - 45) / 2 = 15 deg from the top normal.
+  const VProfile f = fit_v_profile(v_profile(0.006, 45, 75, 0.0, 0.0, 1), 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_NEAR(f.root.x(), 0.0, 1e-5);
+  EXPECT_NEAR(f.root.y(), -0.006, 1e-5);
+  EXPECT_NEAR(f.wall_left_deg, 45.0, 0.1);
+  EXPECT_NEAR(f.wall_right_deg, 75.0, 0.1);
+  EXPECT_NEAR(std::atan2(f.bisector.x(), f.bisector.y()) * 180 / M_PI, -15.0, 0.2);
+}
+
+TEST(RobustSection, RoundedRimsAndRootGapDoNotPullTheRoot) {
+  // What stereo matching and the root gap do: rims rounded over 0.8 mm, a 0.5 mm gap at the
+  // root seen down to 2 mm deeper. The fit ignores points near the three vertices.
+  std::vector<Eigen::Vector2d> pts = v_profile(0.008, 60, 60, 0.0, 0.0, 1);
+  const double half = 0.008 / std::tan(M_PI / 3);
+  for (auto& p : pts) {
+    const double d = std::abs(std::abs(p.x()) - half);
+    if (d < 0.0008) p.y() -= 0.0003 * (1 - d / 0.0008);  // rounded rim
+    if (std::abs(p.x()) < 0.00025) p.y() = -0.010;       // the gap shows the table
+  }
+  const VProfile f = fit_v_profile(pts, 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_NEAR(f.root.x(), 0.0, 5e-5);
+  EXPECT_NEAR(f.root.y(), -0.008, 1e-4);
+  EXPECT_NEAR(f.width, 2 * half, 2e-4);
+}
+
+TEST(RobustSection, OneWallSeenKeepsTheOpeningAndRoot) {
+  // The left wall at a grazing angle returns nothing: the top ends at its rim.
+  std::vector<Eigen::Vector2d> pts;
+  const double half = 0.008 / std::tan(M_PI / 3);
+  for (const auto& p : v_profile(0.008, 60, 60, 0.0, 0.0001, 3)) {
+    if (p.x() > -half && p.x() < 0) continue;
+    pts.push_back(p);
+  }
+  const VProfile f = fit_v_profile(pts, 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_TRUE(f.one_wall);
+  EXPECT_NEAR(f.edge_right.x(), half, 3e-4);
+  EXPECT_NEAR(f.edge_left.x(), -half, 8e-4);  // within a sample spacing
+  EXPECT_NEAR(f.root.x(), 0.0, 5e-4);
+}
+
+TEST(RobustSection, CurvedTopOfAPipeIsNotAGroove) {
+  // A V in a pipe's crown (radius 50 mm): the top is fitted as a curve, the root found.
+  std::vector<Eigen::Vector2d> pts = v_profile(0.008, 60, 60, 0.0, 0.0, 1);
+  for (auto& p : pts) p.y() -= p.x() * p.x() / (2 * 0.05);
+  const VProfile f = fit_v_profile(pts, 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_NEAR(f.root.x(), 0.0, 2e-4);
+  EXPECT_NEAR(f.root.y(), -0.008, 4e-4);
+}
+
+TEST(RobustSection, ConvexEdgeStepAndFlatAreRejected) {
+  // A ridge (an inverted V): nothing below the top.
+  std::vector<Eigen::Vector2d> ridge = v_profile(0.008, 60, 60, 0.0, 0.0, 1);
+  for (auto& p : ridge) p.y() = -p.y();
+  EXPECT_FALSE(fit_v_profile(ridge, 0.02).ok);
+  // A step down to a table (a part's edge): the two sides do not continue each other.
+  std::vector<Eigen::Vector2d> step;
+  for (double u = -0.02; u <= 0.02; u += 0.0005) step.emplace_back(u, u < 0.003 ? -0.010 : 0.0);
+  EXPECT_FALSE(fit_v_profile(step, 0.02).ok);
+  // A flat with noise.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> gauss(0.0, 0.0005);
+  std::vector<Eigen::Vector2d> flat;
+  for (double u = -0.02; u <= 0.02; u += 0.0005) flat.emplace_back(u, gauss(rng));
+  EXPECT_FALSE(fit_v_profile(flat, 0.02).ok);
+  // Too few points.
+  EXPECT_FALSE(fit_v_profile({{0, 0}, {0.001, 0}}, 0.02).ok);
+}
+
+TEST(RobustSection, SectionIn3DMapsTheProfileBack) {
+  // A straight V along +y in a plate z = 0 (up = +z), sampled densely in 3-D.
+  Cloud c;
+  for (double y = -0.004; y <= 0.004; y += 0.0008) {
+    for (const auto& p : v_profile(0.006, 60, 60, 0.002, 0.0, 1, 0.0008, 1)) {
+      c.x.push_back(static_cast<float>(p.x()));
+      c.y.push_back(static_cast<float>(y));
+      c.z.push_back(static_cast<float>(p.y()));
+    }
+  }
+  c.width = static_cast<std::uint32_t>(c.x.size());
+  std::vector<std::uint32_t> all(c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+  const GrooveSection s = fit_section(c, all, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                      Eigen::Vector3d(0, 0, 1), 0.0015, 0.02);
+  ASSERT_TRUE(s.ok) << s.why;
+  EXPECT_NEAR((s.root - Eigen::Vector3d(0.002, 0, -0.006)).norm(), 0.0, 2e-5);
+  EXPECT_NEAR(s.bisector.z(), 1.0, 1e-4);
+  EXPECT_NEAR(s.normal.z(), 1.0, 1e-4);
+  // across = normal x tangent = z x y = -x: u grows towards the right edge.
+  EXPECT_GT((s.edge_right - s.edge_left).dot(s.across()), 0.0);
+  EXPECT_NEAR(s.across().x(), -1.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace groovetrace

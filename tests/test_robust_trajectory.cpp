@@ -1,0 +1,84 @@
+// Torch poses along a traced seam (robust_trajectory.cpp): arc-length spacing, slices, the
+// travel direction convention, tool axis into the workpiece, continuous rotation vectors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <groovetrace/robust.hpp>
+
+namespace groovetrace {
+namespace {
+
+// A seam along a quarter circle (radius 50 mm, z = 0.4 m, camera looking along +z), traced
+// from +y round to -x... so that its end lies at smaller x than its start.
+SeamCandidate quarter_circle() {
+  SeamCandidate s;
+  for (int k = 0; k <= 100; ++k) {
+    const double a = M_PI / 2 * k / 100;
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(0.05 * std::cos(a), 0.05 * std::sin(a), 0.4);
+    g.tangent = Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);  // towards the camera at the origin
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  return s;
+}
+
+TEST(RobustTrajectory, StepsAlongTheArcInTravelOrder) {
+  const SeamCandidate s = quarter_circle();
+  RobustParams p;
+  p.step = 0.002;
+  const Trajectory t = seam_trajectory(s, p);
+  const double length = 0.05 * M_PI / 2;
+  EXPECT_NEAR(t.length, length, 1e-4);
+  EXPECT_EQ(t.waypoints.size(), static_cast<std::size_t>(std::ceil(length / 0.002)) + 1);
+  // Travel ends at larger x than it starts: the seam was reversed.
+  EXPECT_GT(t.waypoints.back().position.x(), t.waypoints.front().position.x());
+  for (std::size_t k = 0; k < t.waypoints.size(); ++k) {
+    const Waypoint& w = t.waypoints[k];
+    EXPECT_NEAR(std::hypot(w.position.x(), w.position.y()), 0.05, 1e-4);
+    const Eigen::Matrix3d R = w.orientation.toRotationMatrix();
+    EXPECT_GT(R.col(2).dot(Eigen::Vector3d(0, 0, 1)), 0.9999);  // into the workpiece
+    if (k == 0) continue;
+    const Eigen::Vector3d step = w.position - t.waypoints[k - 1].position;
+    EXPECT_LE(step.norm(), 0.002 + 1e-9);
+    EXPECT_GT(R.col(0).dot(step.normalized()), 0.99);  // tool x along the travel
+    EXPECT_LT((w.rotation_vector - t.waypoints[k - 1].rotation_vector).norm(), 0.1);
+  }
+}
+
+TEST(RobustTrajectory, SlicesGiveThatManyWaypoints) {
+  RobustParams p;
+  p.slices = 30;
+  EXPECT_EQ(seam_trajectory(quarter_circle(), p).waypoints.size(), 30u);
+}
+
+TEST(RobustTrajectory, ClosedSeamReturnsToItsStart) {
+  SeamCandidate s;
+  for (int k = 0; k < 200; ++k) {
+    const double a = 2 * M_PI * k / 200;
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(0.04 * std::cos(a), 0.04 * std::sin(a), 0.4);
+    g.tangent = Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.closed = true;
+  s.accepted = true;
+  const Trajectory t = seam_trajectory(s, RobustParams{});
+  ASSERT_GT(t.waypoints.size(), 100u);
+  EXPECT_LT((t.waypoints.front().position - t.waypoints.back().position).norm(), 1e-9);
+  // Starts at the smallest x.
+  EXPECT_NEAR(t.waypoints.front().position.x(), -0.04, 1e-4);
+}
+
+TEST(RobustTrajectory, TooShortSeamThrowsNoGroove) {
+  SeamCandidate s;
+  s.sections.resize(1);
+  EXPECT_THROW(seam_trajectory(s, RobustParams{}), std::exception);
+}
+
+}  // namespace
+}  // namespace groovetrace
