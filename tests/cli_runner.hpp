@@ -31,11 +31,13 @@ inline std::filesystem::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-/// `args` is appended to the CLI path as shell words (quote paths with spaces yourself).
-inline CliResult run_cli(const std::string& args, const std::filesystem::path& scratch) {
+/// `args` is appended to the CLI path as shell words (quote paths with spaces yourself);
+/// `env` (e.g. "VAR=value") is put before the command.
+inline CliResult run_cli(const std::string& args, const std::filesystem::path& scratch,
+                         const std::string& env = "") {
   const auto out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-  const std::string cmd = std::string(GT_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
-                          err.string();
+  const std::string cmd = env + " " + std::string(GT_CLI_PATH) + " " + args + " >" +
+                          out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -77,12 +77,14 @@ int run(const RunOptions& opt) {
   say("groovetrace: read %s: %zu points (%ux%u), %zu valid [%.0f ms]\n", opt.scan.c_str(),
       cloud.size(), cloud.width, cloud.height, cloud.count_valid(), load_ms);
 
-  std::unique_ptr<FeatureBackend> backend = make_backend(params.backend);
+  std::unique_ptr<FeatureBackend> backend = make_backend(params.backend, params.device);
   say("groovetrace: backend %s (%s)\n", backend->name().c_str(), backend->device().c_str());
   RunResult result = run_pipeline(cloud, params, *backend, [&](const std::string& stage, double ms) {
     say("groovetrace: %-10s %8.0f ms\n", stage.c_str(), ms);
   });
   result.timings_ms.insert(result.timings_ms.begin(), {"load", load_ms});
+  // A backend that fell back (auto without a usable OpenCL device) says why, in report.json too.
+  if (!backend->warning().empty()) result.warnings.insert(result.warnings.begin(), backend->warning());
   for (const auto& w : result.warnings) std::fprintf(stderr, "groovetrace: warning: %s\n", w.c_str());
 
   const auto t_write = std::chrono::steady_clock::now();

@@ -1,0 +1,65 @@
+// Backend choice from the CLI when no OpenCL platform exists: `auto` falls back to the CPU
+// backend and says so; an explicit `opencl` is an error (exit 5), not a silent fallback.
+#include <gtest/gtest.h>
+#include <groovetrace/cloud_io.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "scenes.hpp"
+
+namespace groovetrace {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The ICD loader finds platforms through the vendor files in this directory; an empty one
+// means no OpenCL platform at all, as on a machine without a driver.
+const char* kNoOpenCl = "OCL_ICD_VENDORS=/nonexistent-groovetrace-icd";
+
+class CliBackend : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    test::VGrooveScene s;
+    s.width = 320;
+    s.height = 240;
+    scan_ = dir_ / "scan.pcd";
+    write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));
+  }
+  fs::path dir_, scan_;
+};
+
+TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend auto",
+                               dir_, kNoOpenCl);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  ASSERT_FALSE(report["warnings"].empty());
+  EXPECT_NE(report["warnings"][0].get<std::string>().find("OpenCL unavailable"),
+            std::string::npos);
+}
+
+TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_, kNoOpenCl);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
+}
+
+TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
+                                   " --backend opencl --device no-such-device-name",
+                               dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no-such-device-name"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace groovetrace
