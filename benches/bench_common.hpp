@@ -82,10 +82,11 @@ inline pcl::PointCloud<pcl::PointXYZ>::Ptr to_pcl(const Cloud& c) {
 // counts of docs/benchmarks.md: per valid query point, the candidates tested (one per lane and
 // window position, `lanes` queries per work-item sharing the widest ellipse) and the
 // neighbours within r among them. The slack (how far points sit off their pixel rays: about 0
-// for a rendered frame, a pixel after smoothing) is the 99.99th percentile of the projection
-// residuals, as the backend estimates it, here from the frames' known intrinsics.
+// for a rendered frame, a few tenths of a pixel after smoothing) is the 90th percentile of the
+// projection residuals, as the backend estimates it, here from the frames' known intrinsics.
 struct WalkStats {
   double candidates_per_point = 0, neighbours_per_point = 0, slack_px = 0;
+  double active_fraction = 0;  // of window positions, those where some lane has a neighbour
 };
 inline WalkStats organized_walk(const Cloud& c, float r, int lanes) {
   const int w = static_cast<int>(c.width), h = static_cast<int>(c.height);
@@ -97,10 +98,10 @@ inline WalkStats organized_walk(const Cloud& c, float r, int lanes) {
     const double dv = static_cast<double>(i / w) - (f * c.y[i] / c.z[i] + 0.5 * h);
     residual.push_back(std::max(std::abs(du), std::abs(dv)));
   }
-  auto q = residual.begin() + static_cast<std::ptrdiff_t>(0.9999 * (residual.size() - 1));
+  auto q = residual.begin() + static_cast<std::ptrdiff_t>(0.9 * (residual.size() - 1));
   std::nth_element(residual.begin(), q, residual.end());
   const float slack = static_cast<float>(*q);
-  double candidates = 0, neighbours = 0, queries = 0;
+  double candidates = 0, neighbours = 0, queries = 0, steps = 0, active_steps = 0;
   for (int row = 0; row < h; ++row) {
     for (int c0 = 0; c0 < w; c0 += lanes) {
       float rad = 0;
@@ -122,20 +123,23 @@ inline WalkStats organized_walk(const Cloud& c, float r, int lanes) {
         const int t0 = std::max(-hw, -c0 - (lanes - 1)), t1 = std::min(hw, w - 1 - c0);
         if (t0 > t1) continue;
         candidates += static_cast<double>(t1 - t0 + 1) * lanes;
-        for (int q = c0; q < std::min(c0 + lanes, w); ++q) {
-          const std::size_t i = static_cast<std::size_t>(row) * w + q;
-          if (!c.valid(i)) continue;
-          for (int t = t0; t <= t1; ++t) {
+        for (int t = t0; t <= t1; ++t) {
+          int found = 0;
+          for (int q = c0; q < std::min(c0 + lanes, w); ++q) {
+            const std::size_t i = static_cast<std::size_t>(row) * w + q;
             const int col = q + t;
-            if (col < 0 || col >= w) continue;
+            if (!c.valid(i) || col < 0 || col >= w) continue;
             const std::size_t j = static_cast<std::size_t>(rr) * w + col;
-            if (c.valid(j) && (c.point(j) - c.point(i)).squaredNorm() <= r * r) ++neighbours;
+            if (c.valid(j) && (c.point(j) - c.point(i)).squaredNorm() <= r * r) ++found;
           }
+          neighbours += found;
+          steps += 1;
+          active_steps += found > 0 ? 1 : 0;
         }
       }
     }
   }
-  return {candidates / queries, neighbours / queries, slack};
+  return {candidates / queries, neighbours / queries, slack, active_steps / steps};
 }
 
 // The OpenCL backend on the default device, created once (its program build is not what is

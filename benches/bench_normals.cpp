@@ -58,6 +58,7 @@ void walk(benchmark::State& state, const Cloud& c) {
   state.counters["candidates_per_point"] = s.candidates_per_point;
   state.counters["neighbours_per_point"] = s.neighbours_per_point;
   state.counters["slack_px"] = s.slack_px;
+  state.counters["active_fraction"] = s.active_fraction;
 }
 void BM_OrganizedWalk(benchmark::State& state) { walk(state, prepared(state.range(0)).smoothed); }
 void BM_OrganizedWalkRaw(benchmark::State& state) { walk(state, frame(state.range(0))); }

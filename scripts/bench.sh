@@ -12,7 +12,7 @@ BUILD=${1:-build}
 OUT="$BUILD/bench-results"
 mkdir -p "$OUT"
 export GT_BENCH_DIR="$OUT/files"
-uptime >"$OUT/load-before.txt"
+[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || uptime >"$OUT/load-before.txt"
 
 run() {  # program json-name [extra benchmark flags]
   local prog=$1 name=$2
@@ -21,19 +21,28 @@ run() {  # program json-name [extra benchmark flags]
   "$BUILD/benches/$prog" --benchmark_out="$OUT/$name.json" --benchmark_out_format=json "$@" >&2
 }
 
-run bench_normals normals
-run bench_smooth smooth
-run bench_descriptor descriptor
-run bench_pipeline pipeline
-# Each scaling case in its own process, so that its memory peak is its own.
-i=0
-for name in $("$BUILD/benches/bench_scaling" --benchmark_list_tests); do
-  run bench_scaling "scaling-$i" --benchmark_filter="^${name}\$"
-  i=$((i + 1))
+# BENCH_ONLY="normals smooth ..." reruns some programs; BENCH_REPORT_ONLY=1 only rewrites the
+# report from the results already in $OUT.
+only=${BENCH_ONLY:-walk normals smooth descriptor pipeline scaling cli}
+[ "${BENCH_REPORT_ONLY:-0}" = 1 ] && only=""
+# The organized walk's candidate counts (for the flop counts; not a timing).
+case " $only " in *" walk "*) run bench_normals walk --benchmark_filter=OrganizedWalk ;; esac
+for prog in normals smooth descriptor pipeline; do
+  case " $only " in
+    *" $prog "*) run "bench_$prog" "$prog" --benchmark_filter='^BM_(OpenCl|Cpu|Pcl|Run)' ;;
+  esac
 done
+case " $only " in *" scaling "*)
+  # Each scaling case in its own process, so that its memory use is its own.
+  i=0
+  for name in $("$BUILD/benches/bench_scaling" --benchmark_list_tests); do
+    run bench_scaling "scaling-$i" --benchmark_filter="^${name}\$"
+    i=$((i + 1))
+  done ;;
+esac
 
 # The CLI end to end, process start to exit, on the 1280x720 frame bench_pipeline wrote.
-if [ -x "$BUILD/groovetrace" ]; then
+if [ -x "$BUILD/groovetrace" ] && [[ " $only " == *" cli "* ]]; then
   /usr/bin/python3 - "$BUILD/groovetrace" "$GT_BENCH_DIR/frame1280.pcd" "$OUT" <<'EOF'
 import json, subprocess, sys, time
 cli, scan, out = sys.argv[1:4]
@@ -53,7 +62,7 @@ for backend in ("opencl", "cpu"):
 json.dump(result, open(f"{out}/cli.json", "w"), indent=1)
 EOF
 fi
-uptime >"$OUT/load-after.txt"
+[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || uptime >"$OUT/load-after.txt"
 
 /usr/bin/python3 - "$OUT" >docs/benchmarks.md <<'EOF'
 import glob, json, os, platform, statistics, subprocess, sys, time
@@ -109,8 +118,8 @@ p()
 p(f"Written by `scripts/bench.sh` on {time.strftime('%Y-%m-%d %H:%M')}. Machine: {lscpu('Model name')}, "
   f"{cores} cores, {lscpu('L3 cache')} L3; OpenCL device: {device}. Load average before: "
   f"`{load_before.split('load average:')[-1].strip()}`, after: "
-  f"`{load_after.split('load average:')[-1].strip()}` (other work on the machine slows every "
-  "column alike, but not by the same amount).")
+  f"`{load_after.split('load average:')[-1].strip()}`: other work on the machine slows every "
+  "column, not all by the same factor, so ratios from a loaded machine are rough.")
 p()
 p("Input: the rendered V-groove frame of `benches/bench_common.hpp` (1280x720, D415-like "
   "depth noise, 0.4 m, 12 deg tilt), r = 3 mm. Times are wall clock (Google Benchmark real "
@@ -215,11 +224,15 @@ raw_walk = runs.get(f"BM_OrganizedWalkRaw/{W}", {})
 cand = walk.get("candidates_per_point")
 cand_raw = raw_walk.get("candidates_per_point", cand)
 nb = walk.get("neighbours_per_point")
+active = walk.get("active_fraction", 1.0)
+active_raw = raw_walk.get("active_fraction", active)
 p(f"Counted from the kernel source (`kernels/*.cl`): additions, subtractions, "
   "multiplications, square roots, an FMA as 2; comparisons and selects not counted. The "
   "arc cosine and the Gaussian weight are the kernels' own polynomials (22 and 15 flops; "
-  "PoCL's built-in acos runs lane by lane through scalar code). Per candidate, nominal: "
-  "the descriptor and smoothing skip the transcendental part of a candidate no lane keeps. "
+  "PoCL's built-in acos runs lane by lane through scalar code). The descriptor and smoothing "
+  "skip all but the distance test (8 flops) at window positions where no lane has a "
+  f"neighbour: they keep {fmt(100 * active if active else None, 0)}% of the positions on the "
+  f"smoothed frame, {fmt(100 * active_raw if active_raw else None, 0)}% on the raw one. "
   f"The organized walk tests {fmt(cand, 0)} candidates per point on the smoothed frame "
   f"({fmt(cand_raw, 0)} on the raw one, whose points sit exactly on their pixel rays), "
   f"{fmt(nb, 0)} of them within r (`BM_OrganizedWalk` replays the kernels' window walk). "
@@ -227,23 +240,25 @@ p(f"Counted from the kernel source (`kernels/*.cl`): additions, subtractions, "
   "GFLOP/s single precision. Achieved = flops per point x points/s of the whole stage "
   "(upload, search set-up and download included), a lower bound for the kernels alone.")
 p()
-p("| kernel | flops per candidate | candidates per point | per-point finish | flops per point | GFLOP/s | of peak |")
-p("|---|---:|---:|---:|---:|---:|---:|")
+p("| kernel | flops per candidate | candidates per point | kept | per-point finish | flops per point | GFLOP/s | of peak |")
+p("|---|---:|---:|---:|---:|---:|---:|---:|")
 kernels = [
-    # name, flops per candidate, candidates per point, finish flops, benchmark
-    ("mls (order 2: plane pass 46 + quadric pass 85)", 46 + 85, cand_raw, 500,
-     "BM_OpenClSmooth"),
-    ("normals (covariance; eigen-solver per point)", 24, cand, 300, "BM_OpenClNormals"),
-    ("descriptor (+ global_angles per point)", 45, cand, 50, "BM_OpenClDescriptor"),
+    # name, flops per candidate, candidates per point, kept fraction, finish flops, benchmark;
+    # smoothing walks its candidates twice (8 flops of distance test in each pass).
+    ("mls (order 2: plane pass 46 + quadric pass 85)", 46 + 85, cand_raw, active_raw, 500,
+     "BM_OpenClSmooth", 16),
+    ("normals (covariance; eigen-solver per point)", 24, cand, 1.0, 300, "BM_OpenClNormals", 8),
+    ("descriptor (+ global_angles per point)", 45, cand, active, 50, "BM_OpenClDescriptor", 8),
 ]
-for name, per, c, finish, bench in kernels:
+for name, per, c, kept, finish, bench, test in kernels:
     b = runs.get(f"{bench}/{W}", {})
-    if c is None or "points_per_s" not in b:
-        p(f"| {name} | {per} | n/a | {finish} | n/a | n/a | n/a |")
+    if c is None or kept is None or "points_per_s" not in b:
+        p(f"| {name} | {per} | n/a | n/a | {finish} | n/a | n/a | n/a |")
         continue
-    fpp = per * c + finish
+    fpp = c * (test + kept * (per - test)) + finish
     gf = fpp * b["points_per_s"] / 1e9
-    p(f"| {name} | {per} | {c:.0f} | {finish} | {fpp:,.0f} | {gf:.1f} | {100 * gf / peak:.1f}% |")
+    p(f"| {name} | {per} | {c:.0f} | {100 * kept:.0f}% | {finish} | {fpp:,.0f} | {gf:.1f} | "
+      f"{100 * gf / peak:.1f}% |")
 p()
 
 p("## Unorganized clouds: scaling")

@@ -2,10 +2,10 @@
 //
 // Normals at a few millimetres vary by 10-20 degrees on a D415 scan (correlated undulation,
 // 1 mm depth steps), so the evidence here is a height, not an angle: how far a point lies
-// below the plane fitted to everything within ~a groove width of it. A V of depth D scores
-// about D/2 at its root, a flat scores the undulation's residual (tenths of a mm), a convex
-// edge or a pipe's crown scores negative. Points are first merged on 1 mm voxels so that the
-// measure sees surface area, not the sensor's uneven sampling (steep walls, distance).
+// below the upper envelope of everything within ~a groove width of it. A V of depth D scores
+// about 0.7 D at its root, a flat the noise's spread (tenths of a mm), a convex edge or a
+// pipe's crown about zero. Points are first merged on 1 mm voxels so that the measure sees
+// surface area, not the sensor's uneven sampling (steep walls, distance).
 
 #include <algorithm>
 #include <cmath>

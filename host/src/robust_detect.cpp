@@ -414,10 +414,16 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
         }
       }
       // A pass far off the predicted place is another feature, not this seam.
-      // Across the seam the track must hold; in depth a one-wall or gap fit is looser.
+      // Across the seam the track must hold; in depth a one-wall fit is looser. A gap carries
+      // no depth of its own (its root is placed): it must continue the surface - the same
+      // height and a normal within 20 deg - or it may walk off along a shadow.
       const Eigen::Vector3d off = sec.root - at;
-      if ((sec.ok || sec.inferred) && (std::abs(off.dot(sec.across())) > 0.3 * ctx.params.scale ||
-                                       std::abs(off.dot(sec.normal)) > 0.6 * ctx.params.scale)) {
+      const double across_tol = (sec.inferred ? 0.2 : 0.3) * ctx.params.scale;
+      const double depth_tol = (sec.inferred ? 0.2 : 0.6) * ctx.params.scale;
+      const bool turned =
+          sec.inferred && sec.normal.dot(secs.back().normal) < std::cos(20.0 * M_PI / 180);
+      if ((sec.ok || sec.inferred) && (std::abs(off.dot(sec.across())) > across_tol ||
+                                       std::abs(off.dot(sec.normal)) > depth_tol || turned)) {
         sec.ok = sec.inferred = false;
         sec.why = "off the tracked seam";
       }
@@ -436,6 +442,31 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
       }
     }
     if (end == 1) std::reverse(secs.begin(), secs.end());
+  }
+}
+
+// A groove keeps its width and depth along a seam; a V fit far off the seam's medians over
+// all its fits (narrower than 0.6 or wider than 1.6 times, shallower than 0.6 or deeper than
+// 1.5 times) caught something else - a shadow's edge, the table through a dropout - and is
+// not trusted.
+void reject_inconsistent(std::vector<GrooveSection>& secs) {
+  std::vector<double> widths, depths;
+  for (const auto& s : secs) {
+    if (!s.ok) continue;
+    widths.push_back(s.width);
+    depths.push_back(s.depth);
+  }
+  if (widths.size() < 5) return;
+  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double width = widths[widths.size() / 2], depth = depths[depths.size() / 2];
+  for (auto& s : secs) {
+    if (!s.ok) continue;
+    if (s.width < 0.6 * width || s.width > 1.6 * width || s.depth < 0.6 * depth ||
+        s.depth > 1.5 * depth) {
+      s.ok = false;
+      s.why = "inconsistent with the seam";
+    }
   }
 }
 
@@ -486,9 +517,29 @@ void align_bisectors(std::vector<GrooveSection>& secs) {
 // An open seam ends where its groove leaves the part or the view; the last sections there
 // straddle the part's end face or the table. From each end, sections are dropped while their
 // own fit failed (gap-inferred ones stay: a pipe's flanks) or gave a width far from the seam's
-// median.
-void trim_ends(SeamCandidate& seam) {
+// median. Before that, the seam is cut at holes longer than `link` (m).
+void trim_ends(SeamCandidate& seam, double link) {
   auto& secs = seam.sections;
+  // Where smoothing dropped a long stretch (nothing fitted within reach), the curve across it
+  // is a guess: keep the run between such holes that holds the most ok sections.
+  {
+    std::size_t best_lo = 0, best_hi = 0, best_ok = 0, lo = 0;
+    for (std::size_t k = 1; k <= secs.size(); ++k) {
+      if (k < secs.size() && (secs[k].root - secs[k - 1].root).norm() <= link) continue;
+      std::size_t ok = 0;
+      for (std::size_t q = lo; q < k; ++q) ok += secs[q].ok ? 1 : 0;
+      if (ok > best_ok || (ok == best_ok && k - lo > best_hi - best_lo)) {
+        best_ok = ok;
+        best_lo = lo;
+        best_hi = k;
+      }
+      lo = k;
+    }
+    if (best_hi - best_lo < secs.size()) {
+      secs = std::vector<GrooveSection>(secs.begin() + static_cast<std::ptrdiff_t>(best_lo),
+                                        secs.begin() + static_cast<std::ptrdiff_t>(best_hi));
+    }
+  }
   std::vector<double> widths;
   for (const auto& s : secs) {
     if (s.ok) widths.push_back(s.width);
@@ -516,6 +567,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
     SeamCurve curve = smooth_curve(ordered, closed, p.smooth, p.station, normals);
     if (curve.points.size() < 2) break;
     std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals);
+    reject_inconsistent(raw);
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);
@@ -536,7 +588,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
       normals.push_back(s.normal);
     }
   }
-  if (!closed) trim_ends(seam);
+  if (!closed) trim_ends(seam, 1.5 * p.scale);
   // Length, arc lengths and corners along the smoothed roots (for the score and the region).
   if (seam.sections.size() >= 2) {
     std::vector<double> old_s, new_s;
@@ -601,6 +653,30 @@ double collinear_gap(const SeamCandidate& a, const SeamCandidate& b) {
   return best;
 }
 
+// Whether two seams look like stretches of one groove: each made of V fits (40 %), their
+// median widths within 30 % of each other. A bridge across a gap needs that; a chain of
+// shadow-edge fits beside a pipe does not have it.
+bool same_groove(const SeamCandidate& a, const SeamCandidate& b) {
+  auto stats = [](const SeamCandidate& s, double& ok, double& width) {
+    std::vector<double> w;
+    for (const auto& g : s.sections) {
+      if (g.ok) w.push_back(g.width);
+    }
+    ok = s.sections.empty() ? 0.0 : static_cast<double>(w.size()) / s.sections.size();
+    if (w.empty()) {
+      width = 0;
+      return;
+    }
+    std::nth_element(w.begin(), w.begin() + w.size() / 2, w.end());
+    width = w[w.size() / 2];
+  };
+  double oka, wa, okb, wb;
+  stats(a, oka, wa);
+  stats(b, okb, wb);
+  return oka >= 0.4 && okb >= 0.4 && wa > 0 && wb > 0 &&
+         std::abs(wa - wb) <= 0.3 * std::max(wa, wb);
+}
+
 // Seams traced from separate node paths can be one: the tracking of one runs into the other,
 // or both stop short of a corner or of a noisy stretch. The second seam's sections that
 // overlap the first are dropped; when the rest is one run whose end faces an end of the
@@ -647,7 +723,7 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
           }
         }
         bool join = best <= link;
-        if (!join && !trimmed) join = collinear_gap(a, b) <= 3 * link;
+        if (!join && !trimmed) join = collinear_gap(a, b) <= 3 * link && same_groove(a, b);
         if (!join) continue;
         std::vector<Eigen::Vector3d> ordered, normals;
         for (std::size_t q = 0; q < a.sections.size(); ++q) {

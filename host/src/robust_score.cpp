@@ -56,8 +56,8 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
     seam.reason = "fewer than 3 V-shaped sections";
   } else if (seam.length < params.min_length) {
     seam.reason = "shorter than min_length";
-  } else if (seam.ok_fraction < 0.5) {
-    seam.reason = "fewer than half of the sections are V-shaped";
+  } else if (seam.ok_fraction < 0.4) {
+    seam.reason = "fewer than 40 % of the sections are V-shaped";
   } else if (seam.consistency < 0.35) {
     seam.reason = "width or opening varies along the seam";
   } else if (seam.opening_deg < 15 || seam.opening_deg > 160) {

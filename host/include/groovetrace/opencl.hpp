@@ -1,7 +1,11 @@
 #pragma once
 // The OpenCL backend: device discovery, device choice and its typed errors. The kernels are
 // kernels/*.cl, compiled into the library; each device's program is built once per process.
-// No OpenCL header is needed to use this API.
+// No OpenCL header is needed to use this API. Environment variables, for diagnosis:
+// GROOVETRACE_OPENCL_PROFILE=1 prints each kernel's device time to stderr;
+// GROOVETRACE_OPENCL_SEARCH=grid uses the grid search for organized frames too;
+// GROOVETRACE_OPENCL_VW=1|2|4|8|16 sets the queries per work-item (default 16 on CPU devices,
+// 1 on GPUs); GROOVETRACE_OPENCL_OPTIONS adds OpenCL compiler options.
 
 #include <cstdint>
 #include <groovetrace/error.hpp>

@@ -20,8 +20,8 @@ namespace groovetrace {
 /// Settings of the robust method. The defaults are the one configuration used on every shape,
 /// distance, tilt and resolution; only `step`, `slices` and `max_seams` are run parameters.
 struct RobustParams {
-  /// Radius of the concavity measure and half-width of a cross-section's window (m). Grooves
-  /// of a top width from about 0.3 to 1.6 times this are found (default: 4-16 mm).
+  /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
+  /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
   double scale = 0.010;
   double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
   double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
@@ -40,16 +40,17 @@ struct RobustParams {
 struct CreaseMap {
   std::vector<Eigen::Vector3f> points;   ///< voxel centroids (m)
   std::vector<Eigen::Vector3f> normals;  ///< plane normal at `scale`, towards the viewpoint
-  std::vector<float> concavity;          ///< m below the weighted plane fit (> 0: concave)
+  std::vector<float> concavity;          ///< m: upper envelope minus own height (> 0: concave)
   std::vector<std::int32_t> voxel;       ///< per input point: its voxel, -1 if invalid
   double median = 0.0;                   ///< of concavity over voxels (m)
   double sigma = 0.0;                    ///< 1.4826 * MAD of concavity (m)
   double threshold = 0.0;                ///< candidate threshold (m)
 };
 
-/// Voxelizes `cloud` and measures, per voxel, the height of its centroid below the weighted
-/// least-squares plane of the voxels within `params.scale`. The threshold is scale-free:
-/// median + threshold_k * 1.4826 MAD of the measure over the whole cloud.
+/// Voxelizes `cloud` and measures, per voxel, how deep it lies in its neighbourhood: along the
+/// plane normal (PCA of the voxels within `params.scale`), the 80th percentile of the
+/// neighbours' heights minus the voxel's own height averaged within 0.3 `scale`. The threshold
+/// is scale-free: median + threshold_k * 1.4826 MAD of the measure over the whole cloud.
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
 
 /// Crease nodes: candidate voxels that are the deepest across the seam (non-maximum
