@@ -12,7 +12,8 @@ BUILD=${1:-build}
 OUT="$BUILD/bench-results"
 mkdir -p "$OUT"
 export GT_BENCH_DIR="$OUT/files"
-[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || uptime >"$OUT/load-before.txt"
+# A partial rerun keeps the load figures of the full run it completes.
+[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || [ -n "${BENCH_ONLY:-}" ] || uptime >"$OUT/load-before.txt"
 
 run() {  # program json-name [extra benchmark flags]
   local prog=$1 name=$2
@@ -62,7 +63,7 @@ for backend in ("opencl", "cpu"):
 json.dump(result, open(f"{out}/cli.json", "w"), indent=1)
 EOF
 fi
-[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || uptime >"$OUT/load-after.txt"
+[ "${BENCH_REPORT_ONLY:-0}" = 1 ] || [ -n "${BENCH_ONLY:-}" ] || uptime >"$OUT/load-after.txt"
 
 /usr/bin/python3 - "$OUT" >docs/benchmarks.md <<'EOF'
 import glob, json, os, platform, statistics, subprocess, sys, time
@@ -115,8 +116,10 @@ peak = cores * ghz * 64
 p = print
 p("# Benchmarks")
 p()
-p(f"Written by `scripts/bench.sh` on {time.strftime('%Y-%m-%d %H:%M')}. Machine: {lscpu('Model name')}, "
-  f"{cores} cores, {lscpu('L3 cache')} L3; OpenCL device: {device}. Load average before: "
+started = load_before.split()[0] if load_before else "?"
+p(f"Written by `scripts/bench.sh` on {time.strftime('%Y-%m-%d')}, from the run started at "
+  f"{started}. Machine: {lscpu('Model name')}, {cores} cores, {lscpu('L3 cache')} L3; OpenCL "
+  f"device: {device}. Load average before: "
   f"`{load_before.split('load average:')[-1].strip()}`, after: "
   f"`{load_after.split('load average:')[-1].strip()}`: other work on the machine slows every "
   "column, not all by the same factor, so ratios from a loaded machine are rough.")
