@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
+#include <groovetrace/pipeline.hpp>
 #include <numeric>
 #include <random>
 
@@ -229,6 +230,24 @@ TEST(OpenClParity, GrooveLabelsOrganizedAndUnorganized) {
   const Cloud frame = noisy_frame();
   expect_label_parity(*cl, frame, "organized");
   expect_label_parity(*cl, shuffled(frame, 13), "unorganized");
+}
+
+// The paper pipeline end to end on each backend: the same waypoints within 0.1 mm.
+TEST(OpenClParity, PaperTrajectoriesAgree) {
+  REQUIRE_OPENCL(cl);
+  auto cpu = make_cpu_backend();
+  Params params;
+  params.method = "paper";
+  const Cloud frame = noisy_frame();
+  const RunResult ref = run_pipeline(frame, params, *cpu);
+  const RunResult got = run_pipeline(frame, params, *cl);
+  ASSERT_EQ(ref.trajectory.waypoints.size(), got.trajectory.waypoints.size());
+  ASSERT_GE(ref.trajectory.waypoints.size(), 10u);
+  for (std::size_t k = 0; k < ref.trajectory.waypoints.size(); ++k) {
+    EXPECT_LT((ref.trajectory.waypoints[k].position - got.trajectory.waypoints[k].position).norm(),
+              1e-4)
+        << "waypoint " << k;
+  }
 }
 
 // Smoothing moves points off their pixel rays (by about a pixel here): the organized search
