@@ -13,8 +13,15 @@
 #include <cmath>
 #include <groovetrace/robust.hpp>
 
+#include "robust_vmodel.hpp"
+
 namespace groovetrace {
 namespace {
+
+using robust_detail::nearest_piece;
+using robust_detail::top_at;
+using robust_detail::Vec6;
+using robust_detail::VModel;
 
 constexpr double kRadToDeg = 57.295779513082320876;
 
@@ -76,8 +83,6 @@ std::pair<Eigen::Vector3d, double> fit_poly(const std::vector<Eigen::Vector2d>& 
   return {q, sigma};
 }
 
-double top_at(const Eigen::Vector3d& q, double u) { return q[0] + q[1] * u + q[2] * u * u; }
-
 // Angle (deg) by which `wall` (unit, from the edge towards the root) dips below the top's
 // tangent `inward` (unit, along the top towards the groove). Positive: into the material.
 double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool left) {
@@ -85,69 +90,15 @@ double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool 
   return std::atan2(left ? -cross : cross, inward.dot(wall)) * kRadToDeg;
 }
 
-// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held), a root vertex, and the two edges
-// where the walls leave the top at u_left < root.u < u_right.
-struct VModel {
-  Eigen::Vector3d q{0, 0, 0};
-  Eigen::Vector2d root{0, 0};
-  double u_left = 0, u_right = 0;
-  Eigen::Vector2d edge_left() const { return {u_left, top_at(q, u_left)}; }
-  Eigen::Vector2d edge_right() const { return {u_right, top_at(q, u_right)}; }
-};
-
-// Signed distance of p to segment a-b (positive on the left of a->b) or to its nearer end.
-double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                        const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  const Eigen::Vector2d foot = a + t * ab;
-  const double d = (p - foot).norm();
-  const double side = ab.x() * (p - a).y() - ab.y() * (p - a).x();
-  return side >= 0 ? d : -d;
-}
-
-// Piece nearest to p (0 top-left, 1 wall-left, 2 wall-right, 3 top-right) and the signed
-// distance to it (positive above the V, out of the material).
-std::pair<int, double> nearest_piece(const Eigen::Vector2d& p, const VModel& m) {
-  const Eigen::Vector2d el = m.edge_left(), er = m.edge_right();
-  // Walls: from the edge down to the root (left) and from the root up to the edge (right),
-  // so that "left of the direction" is above the material on both.
-  const double dl = segment_distance(p, el, m.root);
-  const double dr = segment_distance(p, m.root, er);
-  auto top_dist = [&](bool left) {
-    const double u = p.x();
-    const double lim = left ? el.x() : er.x();
-    if ((left && u <= lim) || (!left && u >= lim)) {
-      const double slope = m.q[1] + 2 * m.q[2] * u;
-      return (p.y() - top_at(m.q, u)) / std::sqrt(1 + slope * slope);
-    }
-    const Eigen::Vector2d e = left ? el : er;
-    const double d = (p - e).norm();
-    return p.y() >= top_at(m.q, u) ? d : -d;
-  };
-  const double tl = top_dist(true), tr = top_dist(false);
-  int best = 0;
-  double bd = tl;
-  for (const auto& [k, d] : {std::pair<int, double>{1, dl}, {2, dr}, {3, tr}}) {
-    if (std::abs(d) < std::abs(bd)) {
-      best = k;
-      bd = d;
-    }
-  }
-  return {best, bd};
-}
-
 bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
   return (p - m.root).norm() < zone || (p - m.edge_left()).norm() < zone ||
          (p - m.edge_right()).norm() < zone;
 }
 
-// Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with numeric derivatives and
+// Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with analytic derivatives and
 // Tukey weights from the current residuals; steps halved until the robust cost drops.
 bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, double zone,
               double coarse) {
-  using Vec6 = Eigen::Matrix<double, 6, 1>;
   auto pack = [](const VModel& v) {
     Vec6 x;
     x << v.root.x(), v.root.y(), v.u_left, v.u_right, v.q[0], v.q[1];
@@ -168,12 +119,12 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
     for (const auto& p : pts) {
       if (near_vertex(p, v, zone)) continue;
       const double r = nearest_piece(p, v).second / c;
-      sum += std::abs(r) >= 1 ? 1.0 : 1 - std::pow(1 - r * r, 3);
+      const double a = 1 - r * r;
+      sum += std::abs(r) >= 1 ? 1.0 : 1 - a * a * a;
     }
     return sum;
   };
   Vec6 x = pack(m);
-  const double h = 1e-3 * scale + 1e-7;
   // Graduated: a wide Tukey window first, so that a start a few millimetres off still sees
   // the walls, then halving down to the noise.
   for (double stage = std::max(coarse, scale);; stage = std::max(scale, 0.5 * stage)) {
@@ -185,16 +136,10 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
       Vec6 Jtr = Vec6::Zero();
       for (std::size_t k = 0; k < pts.size(); ++k) {
         if (near_vertex(pts[k], cur, zone)) continue;
-        const auto [piece, r] = nearest_piece(pts[k], cur);
+        Vec6 J;
+        const double r = nearest_piece(pts[k], cur, &J).second;
         const double w = tukey(r, c);
         if (w <= 0) continue;
-        Vec6 J;
-        for (int j = 0; j < 6; ++j) {
-          Vec6 xj = x;
-          xj[j] += h;
-          J[j] = (nearest_piece(pts[k], unpack(xj)).second - r) / h;
-        }
-        (void)piece;
         JtJ += w * J * J.transpose();
         Jtr += w * J * r;
       }

@@ -1,0 +1,36 @@
+#pragma once
+// The robust method's V model of a cross-section (internal): a top curve, two walls, a root,
+// and the signed distance of a profile point to it with its derivatives, for the
+// Gauss-Newton fit in robust_section.cpp. Profile coordinates: u across the seam, v along the
+// top normal (out of the workpiece), metres.
+
+#include <Eigen/Core>
+#include <utility>
+
+namespace groovetrace::robust_detail {
+
+/// Top curve height v (m) at u (m): q0 + q1 u + q2 u^2.
+inline double top_at(const Eigen::Vector3d& q, double u) { return q[0] + q[1] * u + q[2] * u * u; }
+
+/// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held in fits), a root vertex, and the
+/// two edges where the walls leave the top at u_left < root.u < u_right (m).
+struct VModel {
+  Eigen::Vector3d q{0, 0, 0};
+  Eigen::Vector2d root{0, 0};
+  double u_left = 0, u_right = 0;
+  Eigen::Vector2d edge_left() const { return {u_left, top_at(q, u_left)}; }
+  Eigen::Vector2d edge_right() const { return {u_right, top_at(q, u_right)}; }
+};
+
+/// The fitted parameters, in this order: root u, root v, u_left, u_right, q0, q1.
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+enum Param { kRootU = 0, kRootV, kLeftU, kRightU, kQ0, kQ1 };
+
+/// Piece of the model nearest to the profile point p (0 top-left, 1 wall-left, 2 wall-right,
+/// 3 top-right) and the signed distance to it (m, positive above the V, out of the material).
+/// With `grad`, also the distance's derivatives with respect to the parameters (Param order),
+/// exact wherever the nearest piece does not change.
+std::pair<int, double> nearest_piece(const Eigen::Vector2d& p, const VModel& m,
+                                     Vec6* grad = nullptr);
+
+}  // namespace groovetrace::robust_detail
