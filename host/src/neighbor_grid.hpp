@@ -3,10 +3,9 @@
 // cells around its own. Cells are found through a hash of the occupied ones, so a cloud
 // spread over metres costs no more memory than a compact one. No neighbour lists are stored.
 
-#include <groovetrace/cloud.hpp>
-
 #include <cmath>
 #include <cstdint>
+#include <groovetrace/cloud.hpp>
 #include <unordered_map>
 #include <vector>
 
@@ -37,6 +36,19 @@ class NeighborGrid {
         }
   }
 
+  /// Occupied cells, for batched queries (see gather_cell).
+  std::size_t cell_count() const { return cell_list_.size(); }
+
+  /// The points of one cell and the candidates of all their balls, gathered once per cell:
+  /// a batch of queries costs 27 cell lookups, not 27 per query.
+  struct CellBlock {
+    std::vector<std::uint32_t> members;  ///< the cell's points (cloud indices)
+    std::vector<std::uint32_t> near;     ///< the points of the 27 cells around it
+    std::vector<float> x, y, z;          ///< their coordinates (m), in `near`'s order
+  };
+  /// Fills `block` for cell `c` (0 <= c < cell_count()); reuses its storage.
+  void gather_cell(std::size_t c, CellBlock& block) const;
+
  private:
   std::int64_t coord(float v) const { return static_cast<std::int64_t>(std::floor(v * inv_cell_)); }
   static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
@@ -50,6 +62,7 @@ class NeighborGrid {
   std::vector<std::uint32_t> order_;  // point indices sorted by cell
   std::vector<float> xs_, ys_, zs_;   // coordinates in that order, for cache-friendly scans
   std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;
+  std::vector<std::uint64_t> cell_list_;  // occupied cells' keys, in sorted order
 };
 
 }  // namespace groovetrace

@@ -8,10 +8,11 @@
 // surface area, not the sensor's uneven sampling (steep walls, distance).
 
 #include <algorithm>
+#include <array>
+#include <climits>
 #include <cmath>
 #include <groovetrace/eigen3.hpp>
 #include <groovetrace/robust.hpp>
-#include <unordered_map>
 
 #include "neighbor_grid.hpp"
 
@@ -24,12 +25,96 @@ constexpr double kEnvelopeQuantile = 0.8;
 // The point's own height is the mean over this fraction of the scale (3 mm at 10 mm).
 constexpr double kOwnRadius = 0.3;
 
-std::uint64_t voxel_key(const Eigen::Vector3f& p, double inv_cell) {
-  const std::uint64_t m = (1u << 21) - 1;
-  auto c = [&](float v) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv_cell))) & m;
-  };
-  return c(p.x()) | (c(p.y()) << 21) | (c(p.z()) << 42);
+// Stable LSD radix sort of (key, index) pairs by key, 16 bits a pass, as many passes as the
+// largest key needs (two for a scan's voxels): a comparison sort of a frame's points costs
+// several times more.
+void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items) {
+  std::uint64_t max_key = 0;
+  for (const auto& e : items) max_key = std::max(max_key, e.first);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> out(items.size());
+  std::vector<std::size_t> start(65537);
+  for (int shift = 0; shift < 64 && (max_key >> shift) != 0; shift += 16) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const auto& e : items) ++start[((e.first >> shift) & 0xFFFF) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    for (const auto& e : items) out[start[(e.first >> shift) & 0xFFFF]++] = e;
+    items.swap(out);
+  }
+}
+
+// The valid points keyed by voxel: the voxel's index in the box of voxels around the cloud
+// (x fastest, then y, then z), so that key order is spatial order and keys stay small.
+std::vector<std::pair<std::uint64_t, std::uint32_t>> voxel_keys(const Cloud& cloud,
+                                                                double inv_cell) {
+  std::vector<std::array<std::int64_t, 3>> cells;
+  std::vector<std::uint32_t> index;
+  cells.reserve(cloud.size());
+  index.reserve(cloud.size());
+  std::array<std::int64_t, 3> lo{INT64_MAX, INT64_MAX, INT64_MAX},
+      hi{INT64_MIN, INT64_MIN, INT64_MIN};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!cloud.valid(i)) continue;
+    const std::array<std::int64_t, 3> c{
+        static_cast<std::int64_t>(std::floor(cloud.x[i] * inv_cell)),
+        static_cast<std::int64_t>(std::floor(cloud.y[i] * inv_cell)),
+        static_cast<std::int64_t>(std::floor(cloud.z[i] * inv_cell))};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], c[a]);
+      hi[a] = std::max(hi[a], c[a]);
+    }
+    cells.push_back(c);
+    index.push_back(static_cast<std::uint32_t>(i));
+  }
+  // Valid coordinates are finite floats, so each extent is below 2^21 voxels of 1 mm unless
+  // the cloud spans kilometres; a key then still fits when the product does.
+  const double nx = static_cast<double>(hi[0] - lo[0] + 1),
+               ny = static_cast<double>(hi[1] - lo[1] + 1);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(cells.size());
+  const bool dense = cells.empty() || nx * ny * static_cast<double>(hi[2] - lo[2] + 1) < 1.8e19;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const auto& c = cells[k];
+    std::uint64_t key;
+    if (dense) {
+      key = static_cast<std::uint64_t>(c[0] - lo[0]) +
+            static_cast<std::uint64_t>(nx) *
+                (static_cast<std::uint64_t>(c[1] - lo[1]) +
+                 static_cast<std::uint64_t>(ny) * static_cast<std::uint64_t>(c[2] - lo[2]));
+    } else {  // an absurd extent: 21 bits per axis, wrapping (voxels still grouped, not ordered)
+      const std::uint64_t m = (1u << 21) - 1;
+      key = (static_cast<std::uint64_t>(c[0]) & m) |
+            ((static_cast<std::uint64_t>(c[1]) & m) << 21) |
+            ((static_cast<std::uint64_t>(c[2]) & m) << 42);
+    }
+    keyed[k] = {key, index[k]};
+  }
+  return keyed;
+}
+
+// The k-th smallest of `values` (k < size), exactly as std::nth_element finds it but without
+// its unpredictable branches, which cost more than the rest of a voxel's work: count the
+// values into 256 bins between their min and max, then select within the one bin that holds
+// the k-th.
+double kth_smallest(const std::vector<double>& values, std::size_t k, std::vector<double>& bin) {
+  double lo = values[0], hi = values[0];
+  for (const double v : values) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (!(hi > lo)) return lo;
+  constexpr int kBins = 256;
+  const double scale = kBins / (hi - lo);
+  auto bin_of = [&](double v) { return std::min(kBins - 1, static_cast<int>((v - lo) * scale)); };
+  std::array<std::uint32_t, kBins> counts{};
+  for (const double v : values) ++counts[bin_of(v)];
+  int b = 0;
+  std::size_t below = 0;
+  while (below + counts[b] <= k) below += counts[b++];
+  bin.clear();
+  for (const double v : values) {
+    if (bin_of(v) == b) bin.push_back(v);
+  }
+  std::nth_element(bin.begin(), bin.begin() + (k - below), bin.end());
+  return bin[k - below];
 }
 
 // Median and 1.4826 * MAD of the finite values (NaN for none).
@@ -66,20 +151,21 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params) {
   CreaseMap map;
   const double inv_cell = 1.0 / params.cell;
   map.voxel.assign(cloud.size(), -1);
-  std::unordered_map<std::uint64_t, std::int32_t> index;
+  // Voxels by sorting the points' voxel keys (a hash map costs an allocation per point); the
+  // voxels come out in key order, x fastest, so neighbours in space are near in memory.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed = voxel_keys(cloud, inv_cell);
+  radix_sort(keyed);
   std::vector<Eigen::Vector3d> sums;
   std::vector<int> counts;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (!cloud.valid(i)) continue;
-    const Eigen::Vector3f p = cloud.point(i);
-    const auto [it, fresh] = index.emplace(voxel_key(p, inv_cell), static_cast<int>(sums.size()));
-    if (fresh) {
+  for (std::size_t k = 0; k < keyed.size(); ++k) {
+    if (k == 0 || keyed[k].first != keyed[k - 1].first) {
       sums.emplace_back(Eigen::Vector3d::Zero());
       counts.push_back(0);
     }
-    sums[it->second] += p.cast<double>();
-    ++counts[it->second];
-    map.voxel[i] = it->second;
+    const std::uint32_t i = keyed[k].second;
+    sums.back() += cloud.point(i).cast<double>();
+    ++counts.back();
+    map.voxel[i] = static_cast<std::int32_t>(sums.size() - 1);
   }
   const std::size_t n = sums.size();
   map.points.resize(n);
@@ -94,42 +180,74 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params) {
   const double disc = 3.14159 * params.scale * params.scale / (params.cell * params.cell);
   const int min_count = std::max(10, static_cast<int>(0.1 * disc));
   const double own_r2 = std::pow(kOwnRadius * params.scale, 2);
-  const std::int64_t count = static_cast<std::int64_t>(n);
+  const std::int64_t cells = static_cast<std::int64_t>(grid.cell_count());
+  const float r2 = radius * radius;
 #pragma omp parallel
   {
-    std::vector<double> heights, own;
-#pragma omp for schedule(dynamic, 256)
-    for (std::int64_t v = 0; v < count; ++v) {
-      const Eigen::Vector3f p = map.points[v];
-      Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
-      Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
-      int found = 0;
-      grid.for_each_within(p, radius, [&](std::uint32_t j, float) {
-        const Eigen::Vector3d d = (map.points[j] - p).cast<double>();
-        s1 += d;
-        s2 += d * d.transpose();
-        ++found;
-      });
-      if (found < min_count) continue;
-      const Eigen::Vector3d mean = s1 / found;
-      Eigen::Vector3d normal = smallest_eigenvector(s2 / found - mean * mean.transpose());
-      if (normal.dot((cloud.viewpoint - p).cast<double>()) < 0) normal = -normal;
-      // Upper envelope of the neighbourhood (a high quantile of the heights along the normal)
-      // minus the point's own height averaged over a small ball (its noise averaged out).
-      heights.clear();
-      own.clear();
-      grid.for_each_within(p, radius, [&](std::uint32_t j, float d2) {
-        const double h = normal.dot((map.points[j] - p).cast<double>());
-        heights.push_back(h);
-        if (d2 <= own_r2) own.push_back(h);
-      });
-      const std::size_t q = static_cast<std::size_t>(kEnvelopeQuantile * (heights.size() - 1));
-      std::nth_element(heights.begin(), heights.begin() + q, heights.end());
-      double own_mean = 0;
-      for (double h : own) own_mean += h;
-      own_mean /= std::max<std::size_t>(own.size(), 1);
-      map.normals[v] = normal.cast<float>();
-      map.concavity[v] = static_cast<float>(heights[q] - own_mean);
+    // The candidates come per grid cell (all of a cell's voxels share them), so the distance
+    // test is one tight loop over contiguous coordinates.
+    NeighborGrid::CellBlock block;
+    // The ball of one voxel, relative to it (m), compacted without branches.
+    std::vector<float> bx, by, bz, bd2;
+    std::vector<double> heights, bin;
+#pragma omp for schedule(dynamic, 4)
+    for (std::int64_t c = 0; c < cells; ++c) {
+      grid.gather_cell(static_cast<std::size_t>(c), block);
+      const std::size_t m = block.near.size();
+      bx.resize(m + 1);
+      by.resize(m + 1);
+      bz.resize(m + 1);
+      bd2.resize(m + 1);
+      for (const std::uint32_t v : block.members) {
+        const Eigen::Vector3f p = map.points[v];
+        std::size_t found = 0;
+        for (std::size_t k = 0; k < m; ++k) {
+          const float ex = block.x[k] - p.x(), ey = block.y[k] - p.y(), ez = block.z[k] - p.z();
+          const float d2 = ex * ex + ey * ey + ez * ez;
+          bx[found] = ex;
+          by[found] = ey;
+          bz[found] = ez;
+          bd2[found] = d2;
+          found += d2 <= r2 ? 1 : 0;
+        }
+        if (found < static_cast<std::size_t>(min_count)) continue;
+        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+        for (std::size_t k = 0; k < found; ++k) {
+          const double dx = bx[k], dy = by[k], dz = bz[k];
+          mx += dx;
+          my += dy;
+          mz += dz;
+          xx += dx * dx;
+          xy += dx * dy;
+          xz += dx * dz;
+          yy += dy * dy;
+          yz += dy * dz;
+          zz += dz * dz;
+        }
+        const double count_d = static_cast<double>(found);
+        const Eigen::Vector3d mean = Eigen::Vector3d(mx, my, mz) / count_d;
+        Eigen::Matrix3d s2;
+        s2 << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+        Eigen::Vector3d normal = smallest_eigenvector(s2 / count_d - mean * mean.transpose());
+        if (normal.dot((cloud.viewpoint - p).cast<double>()) < 0) normal = -normal;
+        // Upper envelope of the neighbourhood (a high quantile of the heights along the
+        // normal) minus the point's own height averaged over a small ball (its noise averaged
+        // out).
+        heights.resize(found);
+        double own_sum = 0;
+        int own_count = 0;
+        for (std::size_t k = 0; k < found; ++k) {
+          const double h = normal.x() * bx[k] + normal.y() * by[k] + normal.z() * bz[k];
+          heights[k] = h;
+          const bool own = bd2[k] <= own_r2;
+          own_sum += own ? h : 0.0;
+          own_count += own ? 1 : 0;
+        }
+        const std::size_t q = static_cast<std::size_t>(kEnvelopeQuantile * (found - 1));
+        const double envelope = kth_smallest(heights, q, bin);
+        map.normals[v] = normal.cast<float>();
+        map.concavity[v] = static_cast<float>(envelope - own_sum / std::max(own_count, 1));
+      }
     }
   }
   const auto [median, sigma] = robust_location_scale(map.concavity);
