@@ -1,9 +1,11 @@
 // Backend choice from the CLI when no OpenCL platform exists: `auto` falls back to the CPU
 // backend and says so; an explicit `opencl` is an error (exit 5), not a silent fallback.
 #include <gtest/gtest.h>
-#include <groovetrace/cloud_io.hpp>
 
+#include <groovetrace/cloud_io.hpp>
+#include <groovetrace/opencl.hpp>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli_runner.hpp"
 #include "scenes.hpp"
@@ -39,8 +41,7 @@ TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
   EXPECT_EQ(report["backend"], "cpu");
   ASSERT_FALSE(report["warnings"].empty());
-  EXPECT_NE(report["warnings"][0].get<std::string>().find("OpenCL unavailable"),
-            std::string::npos);
+  EXPECT_NE(report["warnings"][0].get<std::string>().find("OpenCL unavailable"), std::string::npos);
 }
 
 TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
@@ -50,6 +51,28 @@ TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
+}
+
+// A kernel build failure on an explicit `--backend opencl`: exit 5, one line that names the
+// file holding the compiler's full output, and no outputs.
+TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const std::string env =
+      "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";  // common.cl refuses it
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_, env);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  // One line of ours; PoCL's compiler prints its own count of errors to stderr as well.
+  std::istringstream lines(r.err);
+  int ours = 0;
+  for (std::string line; std::getline(lines, line);) ours += line.rfind("groovetrace:", 0) == 0;
+  EXPECT_EQ(ours, 1) << r.err;
+  EXPECT_NE(r.err.find("failed to build"), std::string::npos) << r.err;
+  const fs::path log = dir_ / "groovetrace-opencl-build.log";
+  EXPECT_NE(r.err.find(log.string()), std::string::npos) << r.err;
+  EXPECT_NE(test::read_text(log).find("VW must be"), std::string::npos);
   EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
 }
 

@@ -1,11 +1,29 @@
 // groovetrace CLI: subcommands run, synth, eval. Every failure ends as one line on stderr
 // and the exit code of DESIGN.md.
+#include <filesystem>
+#include <fstream>
 #include <groovetrace/error.hpp>
+#include <groovetrace/opencl.hpp>
 #include <groovetrace/pipeline.hpp>
-
 #include <iostream>
 
 #include "commands.hpp"
+
+namespace {
+
+// A kernel build failure's compiler log runs to many lines: it goes to a file in the temporary
+// directory ($TMPDIR), named on the error's one line. Returns the path, or "" when unwritable.
+std::string save_build_log(const std::string& log) {
+  std::error_code ec;
+  const auto dir = std::filesystem::temp_directory_path(ec);
+  if (ec) return "";
+  const auto path = dir / "groovetrace-opencl-build.log";
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << log;
+  return out.good() ? path.string() : "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using groovetrace::ExitCode;
@@ -33,6 +51,11 @@ int main(int argc, char** argv) {
     for (auto& c : commands) {
       if (c.app->parsed()) return c.run();
     }
+  } catch (const groovetrace::OpenClError& e) {
+    const std::string log = e.build_log().empty() ? "" : save_build_log(e.build_log());
+    std::cerr << "groovetrace: error: " << e.what()
+              << (log.empty() ? "" : " (compiler output: " + log + ")") << "\n";
+    return static_cast<int>(e.code());
   } catch (const groovetrace::Error& e) {
     std::cerr << "groovetrace: error: " << e.what() << "\n";
     return static_cast<int>(e.code());
