@@ -91,8 +91,9 @@ double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool 
 }
 
 bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
-  return (p - m.root).norm() < zone || (p - m.edge_left()).norm() < zone ||
-         (p - m.edge_right()).norm() < zone;
+  const double z2 = zone * zone;
+  return (p - m.root).squaredNorm() < z2 || (p - m.edge_left()).squaredNorm() < z2 ||
+         (p - m.edge_right()).squaredNorm() < z2;
 }
 
 // Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with analytic derivatives and
@@ -143,8 +144,11 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
         JtJ += w * J * J.transpose();
         Jtr += w * J * r;
       }
-      // Levenberg damping keeps unconstrained directions (a wall without points) still.
-      JtJ.diagonal() += Vec6::Constant(1e-6 + 1e-3 * JtJ.diagonal().maxCoeff());
+      // Marquardt damping, relative to each parameter's own curvature (the slope q1 is
+      // dimensionless, the rest metres: a damping shared by all would freeze the slope), plus a
+      // floor that keeps unconstrained directions (a wall without points) still.
+      const double floor = 1e-9 * JtJ.diagonal().maxCoeff() + 1e-12;
+      JtJ.diagonal() = JtJ.diagonal() * (1 + 1e-3) + Vec6::Constant(floor);
       const Vec6 step = -JtJ.ldlt().solve(Jtr);
       if (!step.allFinite()) return false;
       double t = 1.0;
@@ -156,12 +160,12 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
         const double fn = cost(vn);
         if (fn < f) {
           x = xn;
-          improved = f - fn > 1e-9 * (1 + f);
+          improved = f - fn > 1e-6 * (1 + f);
           f = fn;
           break;
         }
       }
-      if (!improved || (t * step).norm() < 1e-4 * scale) break;
+      if (!improved || (t * step).norm() < 1e-6) break;
     }
     if (stage <= scale) break;
   }
