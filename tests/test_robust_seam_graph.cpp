@@ -131,5 +131,22 @@ TEST(RobustSeamGraph, SCurveIsSmoothWithoutCorners) {
   EXPECT_NEAR(c.length, 2 * 0.06 * M_PI / 3, 0.004);
 }
 
+// A straight seam whose node path makes one sharp excursion (a stray node cluster beside the
+// seam, seen on far, tilted 640x480 scans): the chords turn at its tip, the legs do not, so
+// there is no corner and the curve stays near the seam's line beyond the excursion.
+TEST(RobustSeamGraph, ExcursionOfTheNodePathIsNotACorner) {
+  std::vector<Eigen::Vector3d> ordered;
+  for (double x = -0.1; x <= 0.1; x += 0.001) {
+    ordered.emplace_back(x, 0.009 * std::max(0.0, 1 - std::abs(x) / 0.005), 0);
+  }
+  const SeamCurve c = smooth_curve(ordered, false, 0.006, 0.0015);
+  EXPECT_TRUE(c.corners.empty());
+  for (const auto& q : c.points) {
+    if (std::abs(q.x()) > 0.02) {
+      EXPECT_LT(std::abs(q.y()), 0.0005) << q.transpose();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace groovetrace

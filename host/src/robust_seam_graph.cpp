@@ -290,6 +290,22 @@ SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed,
     d2.normalize();
     turn[k] = std::acos(std::clamp(d1.dot(d2), -1.0, 1.0)) * 57.29577951308232;
   }
+  // A corner must hold at the legs' scale too: lines fitted over 2a on either side meet at
+  // kCornerDeg or more. A zigzag of the node path (a stray node at 0.5 m and 640x480) turns
+  // the short chords, not the legs; cutting there would join two straight pieces in a spike.
+  auto legs_turn = [&](std::size_t k) {
+    Eigen::Vector3d p1, d1, p2, d2;
+    if (!local_line(P, S, s[k] - a, a, p1, d1) || !local_line(P, S, s[k] + a, a, p2, d2)) {
+      return 180.0;  // too little on one side to tell: trust the chords
+    }
+    if (normals.size() == n && normals[k].allFinite()) {
+      const Eigen::Vector3d nk = normals[k].normalized();
+      d1 -= d1.dot(nk) * nk;
+      d2 -= d2.dot(nk) * nk;
+    }
+    return std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)) *
+           57.29577951308232;
+  };
   std::vector<double> cuts;
   for (std::size_t k = 0; k < n; ++k) {
     if (turn[k] < kCornerDeg) continue;
@@ -301,7 +317,7 @@ SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed,
         is_max = false;
       }
     }
-    if (is_max) cuts.push_back(s[k]);
+    if (is_max && legs_turn(k) >= kCornerDeg) cuts.push_back(s[k]);
   }
 
   // Pieces between corners; piece j runs from corner j (closed) or the start.
