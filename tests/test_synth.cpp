@@ -291,6 +291,34 @@ TEST(SynthRender, HiddenRootIsNotInView) {
   }
 }
 
+// With the sensor model on, a root vertex whose surface the camera sees beyond the grazing
+// limit (no return at all there) is not in view: a ring round a pipe runs from square-on to
+// edge-on, so both kinds occur.
+TEST(SynthRender, RootBeyondTheGrazingLimitIsNotInView) {
+  gt::SynthParams p;
+  p.shape = gt::Shape::kCylinder;
+  p.width = 640;
+  p.height = 480;
+  const gt::SynthScan with = gt::render(p);
+  p.effects.grazing_dropout = false;
+  const gt::SynthScan without = gt::render(p);
+  const double limit = std::cos(p.sensor.grazing_full_deg * M_PI / 180.0);
+  const gt::Seam& a = with.truth.seams.at(0);
+  const gt::Seam& b = without.truth.seams.at(0);
+  int beyond = 0;
+  for (std::size_t k = 0; k < a.root.size(); ++k) {
+    const double c = a.normal[k].normalized().dot(-a.root[k].normalized());
+    if (a.in_view[k]) {
+      EXPECT_GE(c, limit) << "vertex " << k;
+    }
+    if (b.in_view[k] && c < limit) ++beyond;
+    if (c >= limit) {
+      EXPECT_EQ(a.in_view[k], b.in_view[k]) << "vertex " << k;
+    }
+  }
+  EXPECT_GT(beyond, 0) << "the scene has no root beyond the limit: the test proves nothing";
+}
+
 TEST(SynthRender, EveryShapeRendersWithGroove) {
   for (const std::string& name : gt::shape_names()) {
     gt::SynthParams p;

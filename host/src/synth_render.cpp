@@ -153,6 +153,12 @@ SynthScan render(const SynthParams& params) {
         if (sensor_limits && params.effects.min_z) in = in && c.z() >= params.sensor.min_z;
       }
       in = in && seam.normal[k].dot(eye - p) > 0.0;
+      // Beyond grazing_full_deg of incidence the sensor model returns nothing at all
+      // (simulate_sensor), so no detector can see the groove there.
+      if (sensor_limits && params.effects.grazing_dropout) {
+        const double cos_incidence = seam.normal[k].normalized().dot((eye - p).normalized());
+        in = in && cos_incidence >= std::cos(params.sensor.grazing_full_deg * M_PI / 180.0);
+      }
       const Eigen::Vector3d opening = p + truth.groove.depth * seam.bisector[k];
       in = in && !scene.occluded(eye, opening, kShadowTolerance);
       seam.in_view[k] = in ? 1 : 0;
