@@ -103,6 +103,74 @@ TEST(RobustSection, OneWallSeenKeepsTheOpeningAndRoot) {
   EXPECT_NEAR(f.root.x(), 0.0, 5e-4);
 }
 
+// A 60 deg V (depth 8 mm, no root gap) in a flat top at v = 0, seen as a D415 640x480 sees it
+// from 0.55 m with a tilt of 15 deg across the seam: rays from the sensor at (-0.142, 0.531) m,
+// one image row every 1/502 rad, each row's point taken three times (a 3 mm slab holds ~3
+// columns). The left wall faces away (75 deg incidence) and gets two rows. `blur`: stereo
+// matching's 3-row average of disparity (1 / depth), which rounds the rims and the root.
+std::vector<Eigen::Vector2d> slanted_v_profile(bool blur) {
+  const double depth = 0.008, half = depth * std::tan(M_PI / 6);
+  const Eigen::Vector2d eye(-0.142, 0.531);
+  const Eigen::Vector2d axis = -eye.normalized();
+  std::vector<double> range;
+  std::vector<Eigen::Vector2d> dirs;
+  for (int i = -18; i <= 18; ++i) {
+    const double a = i / 502.0;
+    const Eigen::Vector2d d(std::cos(a) * axis.x() - std::sin(a) * axis.y(),
+                            std::sin(a) * axis.x() + std::cos(a) * axis.y());
+    // First crossing of the ray with the top (v = 0) outside the groove, else a wall.
+    double t = -eye.y() / d.y();
+    const double u = eye.x() + t * d.x();
+    if (std::abs(u) < half) {
+      for (const double side : {-1.0, 1.0}) {
+        // Wall from (side * half, 0) to (0, -depth): n.(p - root) = 0.
+        const Eigen::Vector2d n(depth, -side * half), root(0, -depth);
+        const double tw = n.dot(root - eye) / n.dot(d);
+        const Eigen::Vector2d p = eye + tw * d;
+        if (tw > 0 && side * p.x() >= 0 && side * p.x() <= half && p.y() <= 0) t = tw;
+      }
+    }
+    dirs.push_back(d);
+    range.push_back(t * d.dot(axis));  // depth along the optical axis
+  }
+  std::vector<Eigen::Vector2d> pts;
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    double z = range[i];
+    if (blur && i > 0 && i + 1 < dirs.size()) {
+      z = 1 / (0.25 / range[i - 1] + 0.5 / range[i] + 0.25 / range[i + 1]);
+    }
+    const Eigen::Vector2d p = eye + (z / dirs[i].dot(axis)) * dirs[i];
+    for (int k = 0; k < 3; ++k) pts.push_back(p);
+  }
+  return pts;
+}
+
+TEST(RobustSection, SymmetricFitKeepsTheGrazingWallsRim) {
+  // Stereo matching pulls the grazing wall's lower row up into the groove (the root's rounding
+  // reaches a whole row there); fitted freely from its two rows, that wall comes out several
+  // degrees too flat, its rim ~0.4 mm out and the root ~0.2 mm towards the other wall. Fitted
+  // as a symmetric V, the wall's slope comes from both walls.
+  const double half = 0.008 * std::tan(M_PI / 6);
+  const VProfile f = fit_v_profile(slanted_v_profile(true), 0.02, true);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_FALSE(f.one_wall);
+  EXPECT_NEAR(f.edge_left.x(), -half, 1e-4);
+  EXPECT_NEAR(f.edge_right.x(), half, 2e-4);
+  EXPECT_NEAR(f.root.x(), 0.0, 1e-4);
+  EXPECT_NEAR(f.wall_left_deg, f.wall_right_deg, 0.5);
+  // The profile does show the bias: the free fit's grazing rim lies out by over 0.25 mm.
+  const VProfile free_fit = fit_v_profile(slanted_v_profile(true), 0.02);
+  ASSERT_TRUE(free_fit.ok) << free_fit.why;
+  EXPECT_LT(free_fit.edge_left.x(), -half - 2.5e-4);
+  // A symmetric V fitted either way: the same.
+  const std::vector<Eigen::Vector2d> v = v_profile(0.008, 60, 60, 0.001, 0.0, 1);
+  const VProfile free = fit_v_profile(v, 0.02), sym = fit_v_profile(v, 0.02, true);
+  ASSERT_TRUE(sym.ok) << sym.why;
+  EXPECT_NEAR((sym.root - free.root).norm(), 0.0, 1e-5);
+  EXPECT_NEAR(sym.edge_left.x(), free.edge_left.x(), 1e-5);
+  EXPECT_NEAR(sym.edge_right.x(), free.edge_right.x(), 1e-5);
+}
+
 TEST(RobustSection, CurvedTopOfAPipeIsNotAGroove) {
   // A V in a pipe's crown (radius 50 mm): the top is fitted as a curve, the root found.
   std::vector<Eigen::Vector2d> pts = v_profile(0.008, 60, 60, 0.0, 0.0, 1);

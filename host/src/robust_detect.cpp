@@ -111,12 +111,12 @@ bool grazing(const Context& ctx, const Eigen::Vector3d& p, const Eigen::Vector3d
 // Fits the section at `origin` across the surface tangent; `normal` orients the profile.
 GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
-                         std::vector<std::uint32_t>& scratch) {
+                         std::vector<std::uint32_t>& scratch, bool symmetric = false) {
   const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
   // The ball holds the window across, the slab along and the groove's depth below.
   const double radius = 1.3 * ctx.half_window + slab;
   ctx.bins.within(ctx.cloud, origin, radius, scratch);
-  return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window);
+  return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window, symmetric);
 }
 
 // Arc-length distance between stations a and b (wrapping on rings).
@@ -299,10 +299,12 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
   return out;
 }
 
-// Stations along `curve`, each fitted; normals from the nearest of `hint_points`.
+// Stations along `curve`, each fitted; normals from the nearest of `hint_points`. `symmetric`:
+// fit symmetric V's (see fit_v_profile).
 std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& curve,
                                         const std::vector<Eigen::Vector3d>& hint_points,
-                                        const std::vector<Eigen::Vector3d>& hint_normals) {
+                                        const std::vector<Eigen::Vector3d>& hint_normals,
+                                        bool symmetric) {
   const std::size_t m = curve.points.size();
   std::vector<GrooveSection> secs(m);
   const std::int64_t count = static_cast<std::int64_t>(m);
@@ -321,7 +323,7 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
         }
       }
       secs[k] = section_at(ctx, curve.points[k], curve.tangents[k], hint_normals[best],
-                           ctx.params.slab, scratch);
+                           ctx.params.slab, scratch, symmetric);
       secs[k].s = curve.s[k];
     }
   }
@@ -515,15 +517,26 @@ void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
 // each section's bisector is the top normal turned by the median.
 constexpr double kSymmetricDeg = 8.0;
 
-void align_bisectors(std::vector<GrooveSection>& secs) {
+// The seam's asymmetry (rad, about the tangent, from top normal to bisector): the median over
+// its two-wall sections; NaN with fewer than three.
+double seam_asymmetry(const std::vector<GrooveSection>& secs) {
   std::vector<double> asym;
   for (const auto& s : secs) {
     if (!s.ok || s.one_wall) continue;
     asym.push_back(std::atan2(s.normal.cross(s.bisector).dot(s.tangent), s.normal.dot(s.bisector)));
   }
-  if (asym.size() < 3) return;
+  if (asym.size() < 3) return NAN;
   std::nth_element(asym.begin(), asym.begin() + asym.size() / 2, asym.end());
-  double turn = asym[asym.size() / 2];
+  return asym[asym.size() / 2];
+}
+
+bool symmetric_seam(const std::vector<GrooveSection>& secs) {
+  return std::abs(seam_asymmetry(secs)) < kSymmetricDeg * M_PI / 180;  // false for NaN
+}
+
+void align_bisectors(std::vector<GrooveSection>& secs) {
+  double turn = seam_asymmetry(secs);
+  if (std::isnan(turn)) return;
   if (std::abs(turn) < kSymmetricDeg * M_PI / 180) turn = 0.0;
   for (auto& s : secs) {
     if (!s.ok && !s.inferred) continue;
@@ -580,11 +593,18 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
                          std::vector<Eigen::Vector3d> normals, bool closed) {
   SeamCandidate seam;
   const RobustParams& p = ctx.params;
+  // A symmetric seam (the first pass's walls dip alike, within kSymmetricDeg) is fitted with
+  // symmetric V's the second time: at a slant one wall is seen at a grazing angle, a pixel's
+  // footprint on it stretches to 2-4 mm, and its slope from the two or three image rows it
+  // gets (one of them blurred into the root by stereo matching) comes out several degrees too
+  // flat, which moves its rim out and the root towards the other wall by up to a millimetre.
+  bool symmetric = false;
   for (int pass = 0; pass < 2; ++pass) {
     SeamCurve curve = smooth_curve(ordered, closed, p.smooth, p.station, normals);
     if (curve.points.size() < 2) break;
-    std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals);
+    std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, symmetric);
     reject_inconsistent(raw);
+    if (pass == 0) symmetric = symmetric_seam(raw);
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);

@@ -18,6 +18,12 @@
 namespace groovetrace {
 namespace {
 
+using robust_detail::kLeftU;
+using robust_detail::kQ0;
+using robust_detail::kQ1;
+using robust_detail::kRightU;
+using robust_detail::kRootU;
+using robust_detail::kRootV;
 using robust_detail::nearest_piece;
 using robust_detail::top_at;
 using robust_detail::Vec6;
@@ -99,10 +105,22 @@ bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
 // Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with analytic derivatives and
 // Tukey weights from the current residuals; steps halved until the robust cost drops.
 bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, double zone,
-              double coarse) {
-  auto pack = [](const VModel& v) {
+              double coarse, bool symmetric) {
+  // Free: x = (root u, root v, u_left, u_right, q0, q1). Symmetric: x[2] is the half width h
+  // and x[3] is unused (held at 0); the edges lie at u_c -+ h, u_c the foot of the top normal
+  // through the root (on the top's tangent line there), so both walls dip alike.
+  auto centre_u = [&](const Vec6& x) {
+    const double s = x[5] + 2 * m.q[2] * x[0];
+    const double gap = x[4] + x[5] * x[0] + m.q[2] * x[0] * x[0] - x[1];
+    return x[0] - s * gap / (1 + s * s);
+  };
+  auto pack = [&](const VModel& v) {
     Vec6 x;
     x << v.root.x(), v.root.y(), v.u_left, v.u_right, v.q[0], v.q[1];
+    if (symmetric) {
+      x[2] = 0.5 * (v.u_right - v.u_left);
+      x[3] = 0;
+    }
     return x;
   };
   auto unpack = [&](const Vec6& x) {
@@ -112,7 +130,37 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
     v.u_right = x[3];
     v.q[0] = x[4];
     v.q[1] = x[5];
+    if (symmetric) {
+      const double uc = centre_u(x);
+      v.u_left = uc - x[2];
+      v.u_right = uc + x[2];
+    }
     return v;
+  };
+  // Symmetric: d(free parameters) / d(x), for the chain rule. With s the top's slope at the
+  // root and g its height above the root, u_c = root u - s g / (1 + s^2).
+  auto chain = [&](const Vec6& x) {
+    Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Identity();
+    if (!symmetric) return M;
+    const double s = x[5] + 2 * m.q[2] * x[0];
+    const double g = x[4] + x[5] * x[0] + m.q[2] * x[0] * x[0] - x[1];
+    const double n = 1 + s * s;
+    const double df_ds = g * (1 - s * s) / (n * n), df_dg = s / n;
+    Vec6 du = Vec6::Zero();  // d u_c / d x
+    du[0] = 1 - (df_ds * 2 * m.q[2] + df_dg * s);
+    du[1] = df_dg;
+    du[4] = -df_dg;
+    du[5] = -(df_ds + df_dg * x[0]);
+    M.setZero();
+    M(kRootU, 0) = 1;
+    M(kRootV, 1) = 1;
+    M(kQ0, 4) = 1;
+    M(kQ1, 5) = 1;
+    M.row(kLeftU) = du.transpose();
+    M.row(kRightU) = du.transpose();
+    M(kLeftU, 2) -= 1;
+    M(kRightU, 2) += 1;
+    return M;
   };
   double c = 4.685 * scale;
   auto cost = [&](const VModel& v) {
@@ -133,12 +181,14 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
     double f = cost(unpack(x));
     for (int iter = 0; iter < 30; ++iter) {
       const VModel cur = unpack(x);
+      const Eigen::Matrix<double, 6, 6> M = chain(x);
       Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
       Vec6 Jtr = Vec6::Zero();
       for (std::size_t k = 0; k < pts.size(); ++k) {
         if (near_vertex(pts[k], cur, zone)) continue;
         Vec6 J;
         const double r = nearest_piece(pts[k], cur, &J).second;
+        J = (M.transpose() * J).eval();
         const double w = tukey(r, c);
         if (w <= 0) continue;
         JtJ += w * J * J.transpose();
@@ -264,7 +314,8 @@ PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m,
 
 }  // namespace
 
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window) {
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window,
+                       bool symmetric) {
   VProfile out;
   const double W = half_window;
   std::vector<Eigen::Vector2d> pts;
@@ -359,9 +410,13 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   //    vertices do not count: rounded rims and the root gap are not the V's planes.
   const double scale = std::max(sigma, 0.005 * W);
   const double vertex_zone = std::max(2 * sigma, 0.06 * W);
-  if (!refine_v(pts, m, scale, vertex_zone, 0.1 * W)) {
+  if (!refine_v(pts, m, scale, vertex_zone, 0.1 * W, false)) {
     out.why = "V fit did not converge";
     return out;
+  }
+  if (symmetric) {
+    VModel sym = m;
+    if (refine_v(pts, sym, scale, vertex_zone, 0.1 * W, true)) m = sym;
   }
   const Eigen::Vector2d el = m.edge_left(), er = m.edge_right();
   out.top = m.q;
@@ -553,7 +608,8 @@ std::vector<Eigen::Vector2d> thinned(const std::vector<Eigen::Vector2d>& uv) {
 
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
                           const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
-                          const Eigen::Vector3d& normal_hint, double slab, double half_window) {
+                          const Eigen::Vector3d& normal_hint, double slab, double half_window,
+                          bool symmetric) {
   GrooveSection sec;
   const Profile pr = profile_of(cloud, candidates, origin, tangent, normal_hint, slab);
   if (!pr.ok) {
@@ -561,7 +617,7 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
     return sec;
   }
   sec.support = static_cast<int>(pr.uv.size());
-  const VProfile f = fit_v_profile(thinned(pr.uv), half_window);
+  const VProfile f = fit_v_profile(thinned(pr.uv), half_window, symmetric);
   auto to3 = [&](const Eigen::Vector2d& p) { return pr.at(origin, p.x(), p.y()); };
   sec.tangent = pr.t;
   sec.ok = f.ok;

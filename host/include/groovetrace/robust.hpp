@@ -92,7 +92,12 @@ struct VProfile {
 /// fits, iterated with their intersection), edges where walls meet the top. `ok` only when the
 /// profile is a V: both walls inclined into the material, both top sides present, depth above
 /// the noise. Rims and root, which sensors round off, do not enter the wall fits.
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window);
+/// `symmetric`: the V is known to be symmetric (the seam's walls dip alike): after the free
+/// fit, the walls are refitted with equal dips about the top normal through the root, so a
+/// poorly sampled wall (a grazing view puts two image rows on it) takes its slope from the
+/// other and only its offset from its own points.
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window,
+                       bool symmetric = false);
 
 /// A fitted cross-section in 3-D.
 struct GrooveSection {
@@ -118,9 +123,11 @@ struct GrooveSection {
 /// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
 /// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)
 /// of origin across it. `normal_hint` orients the profile (towards the viewpoint).
+/// `symmetric` as in fit_v_profile.
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
                           const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
-                          const Eigen::Vector3d& normal_hint, double slab, double half_window);
+                          const Eigen::Vector3d& normal_hint, double slab, double half_window,
+                          bool symmetric = false);
 
 /// Where the walls return nothing (seen at a grazing angle) a groove still shows as a gap in
 /// the top surface. Fits that instead of a V: both sides carry top surface, the gap nearest
