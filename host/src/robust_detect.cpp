@@ -433,12 +433,19 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
         }
       }
       // A pass far off the predicted place is another feature, not this seam.
-      // Across the seam the track must hold; in depth a one-wall fit is looser. A gap carries
-      // no depth of its own (its root is placed): it must continue the surface - the same
-      // height and a normal within 20 deg - or it may walk off along a shadow.
+      // Across the seam the track must hold (3 mm). In depth a one-wall fit is looser (6 mm:
+      // its root is where the seen wall meets the axis of a V taken symmetric); a two-wall V
+      // must hold 3 mm too: past a part's end, a slab half on the groove and half on the end
+      // face still fits a V, its root millimetres down the end face (2 mm also cut off true
+      // fits on a far, tilted 640x480 S-curve). A gap carries no depth of its own (its root
+      // is placed): it must continue the surface (2 mm, a normal within 20 deg) or it may walk
+      // off along a shadow.
       const Eigen::Vector3d off = sec.root - at;
       const double across_tol = (sec.inferred ? 0.2 : 0.3) * ctx.params.scale;
-      const double depth_tol = (sec.inferred ? 0.2 : 0.6) * ctx.params.scale;
+      const double depth_tol = (sec.ok && sec.one_wall ? 0.6
+                                : sec.ok               ? 0.3
+                                                       : 0.2) *
+                               ctx.params.scale;
       const bool turned =
           sec.inferred && sec.normal.dot(secs.back().normal) < std::cos(20.0 * M_PI / 180);
       if ((sec.ok || sec.inferred) && (std::abs(off.dot(sec.across())) > across_tol ||
