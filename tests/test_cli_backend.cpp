@@ -34,8 +34,9 @@ class CliBackend : public ::testing::Test {
 
 TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend auto",
-                               dir_, kNoOpenCl);
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend auto --method paper", dir_,
+      kNoOpenCl);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
@@ -47,7 +48,8 @@ TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
 TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
   const fs::path out = dir_ / "out";
   const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_, kNoOpenCl);
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
+      kNoOpenCl);
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
@@ -62,7 +64,8 @@ TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
   const std::string env =
       "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";  // common.cl refuses it
   const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_, env);
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
+      env);
   EXPECT_EQ(r.exit_code, 5) << r.err;
   // One line of ours; PoCL's compiler prints its own count of errors to stderr as well.
   std::istringstream lines(r.err);
@@ -78,10 +81,29 @@ TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
 
 TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
   const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
-                                   " --backend opencl --device no-such-device-name",
+                                   " --method paper --backend opencl --device no-such-device-name",
                                dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("no-such-device-name"), std::string::npos) << r.err;
+}
+
+// The robust method runs on the CPU: report.json says so, and an explicit OpenCL request gets
+// a warning instead of an OpenCL set-up it would not use.
+TEST_F(CliBackend, RobustMethodRunsOnTheCpuAndSaysSo) {
+  const fs::path out = dir_ / "out";
+  auto r = test::run_cli("run " + scan_.string() + " -o " + out.string(), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("groovetrace: warning: --backend and --device apply to --method paper"),
+            std::string::npos)
+      << r.err;
+  report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  EXPECT_FALSE(report["warnings"].empty());
 }
 
 }  // namespace
