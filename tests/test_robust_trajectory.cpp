@@ -25,6 +25,28 @@ SeamCandidate quarter_circle() {
   return s;
 }
 
+// Roots 1.5 mm apart that jitter 0.4 mm across a straight seam (a far 640x480 scan): the
+// tool's x follows the seam's smoothed tangent, not the chord between neighbouring roots,
+// which would swing by up to 28 deg.
+TEST(RobustTrajectory, TravelAxisFollowsTheTangentNotTheRootJitter) {
+  SeamCandidate s;
+  for (int k = 0; k <= 100; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(-0.075 + 0.0015 * k, (k % 2 ? 0.0002 : -0.0002), 0.4);
+    g.tangent = Eigen::Vector3d(k % 3 ? 1 : -1, 0, 0);  // the sign carries no meaning
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  RobustParams p;
+  const Trajectory t = seam_trajectory(s, p);
+  for (const Waypoint& w : t.waypoints) {
+    const Eigen::Vector3d x = w.orientation.toRotationMatrix().col(0);
+    EXPECT_GT(x.x(), std::cos(1.0 * M_PI / 180)) << "at " << w.position.transpose();
+  }
+}
+
 TEST(RobustTrajectory, StepsAlongTheArcInTravelOrder) {
   const SeamCandidate s = quarter_circle();
   RobustParams p;
