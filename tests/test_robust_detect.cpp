@@ -7,6 +7,7 @@
 #include <cmath>
 #include <groovetrace/robust.hpp>
 #include <groovetrace/synth.hpp>
+#include <optional>
 #include <random>
 
 #include "robust_scenes.hpp"
@@ -135,6 +136,14 @@ TEST(RobustDetect, LCornerWaypointsFollowTheLInOrder) {
   EXPECT_GT((a - b).norm(), 0.1);
 }
 
+// The default configuration's best trajectory on a scan; none when no seam is accepted.
+std::optional<Trajectory> best_trajectory(const Cloud& cloud) {
+  const RobustParams p;
+  const RobustDetection d = detect_robust(cloud, p);
+  if (accepted_count(d) == 0) return std::nullopt;
+  return seam_trajectory(*best_accepted(d), p);
+}
+
 // A D415 scan of a straight seam that runs off both ends of its plate (`synth` defaults,
 // 1280x720, seed 7). Near the ends the 10 mm ball of the surface normal holds the plate's
 // end face and the table; the normal must come from the top alone, or the torch tilts along
@@ -143,13 +152,11 @@ TEST(RobustDetect, ToolAxisHoldsUpToThePlateEnds) {
   SynthParams sp;
   sp.seed = 7;
   const SynthScan scan = render(sp);
-  RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
-  ASSERT_GE(accepted_count(d), 1u);
-  const Trajectory t = seam_trajectory(*best_accepted(d), p);
+  const std::optional<Trajectory> t = best_trajectory(scan.cloud);
+  ASSERT_TRUE(t) << "no accepted seam";
   const Seam& truth = scan.truth.seams.at(0);
   double worst = 0;
-  for (const Waypoint& w : t.waypoints) {
+  for (const Waypoint& w : t->waypoints) {
     std::size_t near = 0;
     for (std::size_t k = 1; k < truth.root.size(); ++k) {
       if ((truth.root[k] - w.position).norm() < (truth.root[near] - w.position).norm()) near = k;
@@ -173,13 +180,11 @@ TEST(RobustDetect, SeamEndsStayOnThePart) {
   sp.tilt_deg = 20;
   sp.seed = 103;
   const SynthScan scan = render(sp);
-  RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
-  ASSERT_GE(accepted_count(d), 1u);
-  const Trajectory t = seam_trajectory(*best_accepted(d), p);
+  const std::optional<Trajectory> t = best_trajectory(scan.cloud);
+  ASSERT_TRUE(t) << "no accepted seam";
   const Seam& truth = scan.truth.seams.at(0);
   double worst = 0;
-  for (const Waypoint& w : t.waypoints) {
+  for (const Waypoint& w : t->waypoints) {
     double best = INFINITY;
     for (std::size_t k = 0; k + 1 < truth.root.size(); ++k) {
       const Eigen::Vector3d a = truth.root[k], ab = truth.root[k + 1] - a;
