@@ -250,21 +250,6 @@ TEST(OpenClParity, PaperTrajectoriesAgree) {
   }
 }
 
-// The robust method runs no kernel: given the OpenCL backend, the run still reports the cpu
-// backend that did the work, and the same result.
-TEST(OpenClParity, RobustMethodReportsTheCpuBackend) {
-  REQUIRE_OPENCL(cl);
-  auto cpu = make_cpu_backend();
-  Params params;
-  params.method = "robust";
-  const Cloud frame = noisy_frame();
-  const RunResult ref = run_pipeline(frame, params, *cpu);
-  const RunResult got = run_pipeline(frame, params, *cl);
-  EXPECT_EQ(got.backend, "cpu");
-  EXPECT_EQ(got.device, ref.device);
-  ASSERT_EQ(ref.trajectory.waypoints.size(), got.trajectory.waypoints.size());
-}
-
 // Smoothing moves points off their pixel rays (by about a pixel here): the organized search
 // widens its windows by that slack and stays exact.
 TEST(OpenClParity, OrganizedFrameAfterSmoothing) {

@@ -69,15 +69,9 @@ int run(const RunOptions& opt) {
     }
   };
 
-  // The robust method's stages run on the CPU (docs/method-robust.md): it gets the cpu
-  // backend, so that report.json names what did the work, and no OpenCL set-up (60-110 ms and
-  // a tenth of the run's CPU time on PoCL). --backend and --device are the paper method's.
-  const bool robust = params.method == "robust";
-  const bool device_asked = params.backend != "auto" || !params.device.empty();
   // The backend's set-up overlaps the read.
-  auto backend_ready = std::async(std::launch::async, [&params, robust] {
-    return make_backend(robust ? "cpu" : params.backend, params.device);
-  });
+  auto backend_ready = std::async(
+      std::launch::async, [&params] { return make_backend(params.backend, params.device); });
   ReadOptions ro;
   ro.units_scale = params.units_scale;
   const Cloud cloud = read_cloud(opt.scan, ro);
@@ -96,11 +90,6 @@ int run(const RunOptions& opt) {
   // A backend that fell back (auto without a usable OpenCL device) says why, in report.json too.
   if (!backend->warning().empty())
     result.warnings.insert(result.warnings.begin(), backend->warning());
-  if (robust && device_asked && params.backend != "cpu") {
-    result.warnings.insert(result.warnings.begin(),
-                           "--backend and --device apply to --method paper; the robust method "
-                           "runs on the CPU (OpenMP)");
-  }
   for (const auto& w : result.warnings)
     std::fprintf(stderr, "groovetrace: warning: %s\n", w.c_str());
 

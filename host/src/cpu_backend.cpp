@@ -1,15 +1,15 @@
 // The CPU reference backend: plain loops over a neighbour grid, double accumulation,
 // OpenMP across points. Every OpenCL kernel is checked against these results.
-#include <groovetrace/eigen3.hpp>
-#include <groovetrace/features.hpp>
-
 #include <omp.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <groovetrace/eigen3.hpp>
+#include <groovetrace/features.hpp>
 
+#include "crease_cpu.hpp"
 #include "neighbor_grid.hpp"
 
 namespace groovetrace {
@@ -163,6 +163,10 @@ class CpuBackend final : public FeatureBackend {
       out[i] = static_cast<float>(std::sqrt(var_l * var_l + var_g * var_g));
     }
     return out;
+  }
+
+  CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) override {
+    return crease_cpu(cloud, params);
   }
 };
 

@@ -27,6 +27,9 @@ class FallbackBackend final : public FeatureBackend {
   FeatureSet features(const Cloud& cloud, float radius, int min_neighbors) override {
     return inner_->features(cloud, radius, min_neighbors);
   }
+  CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) override {
+    return inner_->crease(cloud, params);
+  }
 
  private:
   std::unique_ptr<FeatureBackend> inner_;

@@ -54,15 +54,16 @@ void validate(const Params& params) {
 
 namespace {
 
-// --method robust (docs/method-robust.md). Needs no feature backend: its normals are the
-// crease map's plane normals at the groove's scale, its descriptor the concavity (mm).
-void run_robust(const Cloud& cloud, const Params& params, RunResult& r, StageTimer& timer) {
+// --method robust (docs/method-robust.md). The backend measures the creases; its normals are
+// the crease map's plane normals at the groove's scale, its descriptor the concavity (mm).
+void run_robust(const Cloud& cloud, const Params& params, FeatureBackend& backend, RunResult& r,
+                StageTimer& timer) {
   RobustParams rp;
   rp.step = params.step;
   rp.slices = params.slices_given ? params.slices : 0;
   rp.max_seams = params.max_seams;
   r.smoothed = cloud;
-  r.robust = detect_robust(cloud, rp, [&](const std::string& stage) { timer.lap(stage); });
+  r.robust = detect_robust(cloud, rp, backend, [&](const std::string& stage) { timer.lap(stage); });
   r.normals = r.robust.normals;
   r.benchmark_normal = benchmark_normal(r.normals);
   r.descriptor.resize(cloud.size());
@@ -109,12 +110,6 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   RunResult r;
   r.backend = backend.name();
   r.device = backend.device();
-  if (params.method == "robust" && backend.name() != "cpu") {
-    // The robust method's stages are CPU code: the report names what did the work.
-    const auto cpu = make_cpu_backend();
-    r.backend = cpu->name();
-    r.device = cpu->device();
-  }
   StageTimer timer(r.timings_ms, on_stage);
 
   // Calibration files are read first: a typo there should not cost a full run.
@@ -130,7 +125,7 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   const float radius = static_cast<float>(params.radius);
 
   if (params.method == "robust") {
-    run_robust(cloud, params, r, timer);
+    run_robust(cloud, params, backend, r, timer);
     if (T_base_camera) {
       transform_trajectory(r.trajectory, *T_base_camera);
       for (Trajectory& t : r.extra_trajectories) transform_trajectory(t, *T_base_camera);

@@ -12,6 +12,7 @@
 #include <climits>
 #include <cmath>
 #include <groovetrace/eigen3.hpp>
+#include <groovetrace/features.hpp>
 #include <groovetrace/robust.hpp>
 
 #include "neighbor_grid.hpp"
@@ -21,7 +22,7 @@ namespace {
 
 // The top surface must hold only a fifth of the ball for the envelope to find it: a groove as
 // wide as the scale leaves about a third.
-constexpr double kEnvelopeQuantile = 0.8;
+constexpr float kEnvelopeQuantile = 0.8f;
 // The point's own height is the mean over this fraction of the scale (3 mm at 10 mm).
 constexpr double kOwnRadius = 0.3;
 
@@ -90,33 +91,6 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> voxel_keys(const Cloud& clo
   return keyed;
 }
 
-// The k-th smallest of `values` (k < size), exactly as std::nth_element finds it but without
-// its unpredictable branches, which cost more than the rest of a voxel's work: count the
-// values into 256 bins between their min and max, then select within the one bin that holds
-// the k-th.
-double kth_smallest(const std::vector<double>& values, std::size_t k, std::vector<double>& bin) {
-  double lo = values[0], hi = values[0];
-  for (const double v : values) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  if (!(hi > lo)) return lo;
-  constexpr int kBins = 256;
-  const double scale = kBins / (hi - lo);
-  auto bin_of = [&](double v) { return std::min(kBins - 1, static_cast<int>((v - lo) * scale)); };
-  std::array<std::uint32_t, kBins> counts{};
-  for (const double v : values) ++counts[bin_of(v)];
-  int b = 0;
-  std::size_t below = 0;
-  while (below + counts[b] <= k) below += counts[b++];
-  bin.clear();
-  for (const double v : values) {
-    if (bin_of(v) == b) bin.push_back(v);
-  }
-  std::nth_element(bin.begin(), bin.begin() + (k - below), bin.end());
-  return bin[k - below];
-}
-
 // Median and 1.4826 * MAD of the finite values (NaN for none).
 std::pair<double, double> robust_location_scale(const std::vector<float>& values) {
   std::vector<float> v;
@@ -148,6 +122,11 @@ Cloud as_cloud(const std::vector<Eigen::Vector3f>& points) {
 }  // namespace
 
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params) {
+  const auto cpu = make_cpu_backend();
+  return crease_map(cloud, params, *cpu);
+}
+
+CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend) {
   CreaseMap map;
   const double inv_cell = 1.0 / params.cell;
   map.voxel.assign(cloud.size(), -1);
@@ -170,86 +149,21 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params) {
   const std::size_t n = sums.size();
   map.points.resize(n);
   for (std::size_t v = 0; v < n; ++v) map.points[v] = (sums[v] / counts[v]).cast<float>();
-  map.normals.assign(n, Eigen::Vector3f::Constant(NAN));
-  map.concavity.assign(n, NAN);
+  map.normals.resize(n);
 
-  const Cloud voxels = as_cloud(map.points);
-  const float radius = static_cast<float>(params.scale);
-  const NeighborGrid grid(voxels, radius);
+  // The per-voxel work (a plane and a quantile over ~300 voxels each) is the backend's.
+  Cloud voxels = as_cloud(map.points);
+  voxels.viewpoint = cloud.viewpoint;
+  CreaseParams cp;
+  cp.radius = static_cast<float>(params.scale);
+  cp.own_radius = static_cast<float>(kOwnRadius * params.scale);
+  cp.quantile = kEnvelopeQuantile;
   // A plane through fewer voxels than a tenth of a flat disc's is an edge or a speck.
   const double disc = 3.14159 * params.scale * params.scale / (params.cell * params.cell);
-  const int min_count = std::max(10, static_cast<int>(0.1 * disc));
-  const double own_r2 = std::pow(kOwnRadius * params.scale, 2);
-  const std::int64_t cells = static_cast<std::int64_t>(grid.cell_count());
-  const float r2 = radius * radius;
-#pragma omp parallel
-  {
-    // The candidates come per grid cell (all of a cell's voxels share them), so the distance
-    // test is one tight loop over contiguous coordinates.
-    NeighborGrid::CellBlock block;
-    // The ball of one voxel, relative to it (m), compacted without branches.
-    std::vector<float> bx, by, bz, bd2;
-    std::vector<double> heights, bin;
-#pragma omp for schedule(dynamic, 4)
-    for (std::int64_t c = 0; c < cells; ++c) {
-      grid.gather_cell(static_cast<std::size_t>(c), block);
-      const std::size_t m = block.near.size();
-      bx.resize(m + 1);
-      by.resize(m + 1);
-      bz.resize(m + 1);
-      bd2.resize(m + 1);
-      for (const std::uint32_t v : block.members) {
-        const Eigen::Vector3f p = map.points[v];
-        std::size_t found = 0;
-        for (std::size_t k = 0; k < m; ++k) {
-          const float ex = block.x[k] - p.x(), ey = block.y[k] - p.y(), ez = block.z[k] - p.z();
-          const float d2 = ex * ex + ey * ey + ez * ez;
-          bx[found] = ex;
-          by[found] = ey;
-          bz[found] = ez;
-          bd2[found] = d2;
-          found += d2 <= r2 ? 1 : 0;
-        }
-        if (found < static_cast<std::size_t>(min_count)) continue;
-        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-        for (std::size_t k = 0; k < found; ++k) {
-          const double dx = bx[k], dy = by[k], dz = bz[k];
-          mx += dx;
-          my += dy;
-          mz += dz;
-          xx += dx * dx;
-          xy += dx * dy;
-          xz += dx * dz;
-          yy += dy * dy;
-          yz += dy * dz;
-          zz += dz * dz;
-        }
-        const double count_d = static_cast<double>(found);
-        const Eigen::Vector3d mean = Eigen::Vector3d(mx, my, mz) / count_d;
-        Eigen::Matrix3d s2;
-        s2 << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-        Eigen::Vector3d normal = smallest_eigenvector(s2 / count_d - mean * mean.transpose());
-        if (normal.dot((cloud.viewpoint - p).cast<double>()) < 0) normal = -normal;
-        // Upper envelope of the neighbourhood (a high quantile of the heights along the
-        // normal) minus the point's own height averaged over a small ball (its noise averaged
-        // out).
-        heights.resize(found);
-        double own_sum = 0;
-        int own_count = 0;
-        for (std::size_t k = 0; k < found; ++k) {
-          const double h = normal.x() * bx[k] + normal.y() * by[k] + normal.z() * bz[k];
-          heights[k] = h;
-          const bool own = bd2[k] <= own_r2;
-          own_sum += own ? h : 0.0;
-          own_count += own ? 1 : 0;
-        }
-        const std::size_t q = static_cast<std::size_t>(kEnvelopeQuantile * (found - 1));
-        const double envelope = kth_smallest(heights, q, bin);
-        map.normals[v] = normal.cast<float>();
-        map.concavity[v] = static_cast<float>(envelope - own_sum / std::max(own_count, 1));
-      }
-    }
-  }
+  cp.min_neighbors = std::max(10, static_cast<int>(0.1 * disc));
+  CreaseMeasure measure = backend.crease(voxels, cp);
+  map.concavity = std::move(measure.concavity);
+  for (std::size_t v = 0; v < n; ++v) map.normals[v] = measure.normals.normal(v);
   const auto [median, sigma] = robust_location_scale(map.concavity);
   map.median = median;
   map.sigma = sigma;

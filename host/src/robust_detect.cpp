@@ -797,11 +797,18 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
 
 RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               const std::function<void(const std::string&)>& lap) {
+  const auto cpu = make_cpu_backend();
+  return detect_robust(cloud, params, *cpu, lap);
+}
+
+RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
+                              FeatureBackend& backend,
+                              const std::function<void(const std::string&)>& lap) {
   RobustDetection det;
   det.groove.assign(cloud.size(), 0);
   det.concavity.assign(cloud.size(), NAN);
   det.normals.resize(cloud.size());
-  const CreaseMap map = crease_map(cloud, params);
+  const CreaseMap map = crease_map(cloud, params, backend);
   det.threshold = map.threshold;
   det.noise_sigma = map.sigma;
   for (std::size_t i = 0; i < cloud.size(); ++i) {

@@ -3,7 +3,6 @@
 // OpenCL kernels and the CPU reference are interchangeable and checked against each other.
 
 #include <groovetrace/cloud.hpp>
-
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +21,20 @@ struct FeatureSet {
   Normals normals;                   ///< oriented to the viewpoint (cloud frame)
   Eigen::Vector3f benchmark_normal;  ///< u_b (unit; NaN when no point has a normal)
   std::vector<float> descriptor;     ///< D (deg^2), NaN where undefined
+};
+
+/// Settings of the robust method's crease measure (robust.hpp, crease_map).
+struct CreaseParams {
+  float radius = 0.010f;      ///< ball of the plane fit and of the envelope (m)
+  float own_radius = 0.003f;  ///< ball over which a point's own height is averaged (m)
+  float quantile = 0.8f;      ///< the envelope: this quantile of the heights in the ball
+  int min_neighbors = 10;     ///< fewer points in the ball (the point included): NaN
+};
+
+/// The crease measure of every point of a cloud.
+struct CreaseMeasure {
+  Normals normals;               ///< plane normal at `radius`, towards the viewpoint
+  std::vector<float> concavity;  ///< m: envelope minus own height (> 0: concave), NaN
 };
 
 /// Per-point work of the pipeline. Every method keeps input order and size; invalid (NaN)
@@ -52,6 +65,15 @@ class FeatureBackend {
   /// without a normal, or with no neighbour that has one, get NaN.
   virtual std::vector<float> descriptor(const Cloud& cloud, const Normals& normals, float radius,
                                         const Eigen::Vector3f& u_b) = 0;
+
+  /// The robust method's crease measure of each point p (cloud frame, metres): the plane
+  /// normal n of the valid points within `radius` (PCA, flipped towards `cloud.viewpoint`);
+  /// the heights h_j = n . (p_j - p) of those points; concavity = the `quantile` of the h_j
+  /// (the k-th smallest, k = floor(quantile * (count - 1))) minus the mean h_j over the
+  /// points within `own_radius`. NaN normal and concavity below `min_neighbors` points. The
+  /// cpu backend selects the quantile exactly; the opencl backend brackets it and returns the
+  /// bracket's midpoint, within 1e-4 `radius` of it (1 um at 10 mm).
+  virtual CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) = 0;
 
   /// normals(), benchmark_normal() and descriptor() with the same radius, in one call: a
   /// device backend keeps the cloud, its search structure and the normals on the device

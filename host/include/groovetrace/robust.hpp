@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <groovetrace/cloud.hpp>
+#include <groovetrace/features.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <string>
 #include <vector>
@@ -50,7 +51,9 @@ struct CreaseMap {
 /// Voxelizes `cloud` and measures, per voxel, how deep it lies in its neighbourhood: along the
 /// plane normal (PCA of the voxels within `params.scale`), the 80th percentile of the
 /// neighbours' heights minus the voxel's own height averaged within 0.3 `scale`. The threshold
-/// is scale-free: median + threshold_k * 1.4826 MAD of the measure over the whole cloud.
+/// is scale-free: median + threshold_k * 1.4826 MAD of the measure over the whole cloud. The
+/// per-voxel measure runs on `backend` (FeatureBackend::crease); without one, on the cpu.
+CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend);
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
 
 /// Crease nodes: candidate voxels that are the deepest across the seam (non-maximum
@@ -224,7 +227,11 @@ struct RobustDetection {
 
 /// Runs stages 1-4 on `cloud` (metres; viewpoint = the sensor origin in its frame). Never
 /// throws for "no groove": the caller checks whether any seam is accepted. `lap`, when given,
-/// is called after each stage with its name ("candidates", "seams", "region").
+/// is called after each stage with its name ("candidates", "seams", "region"). The crease
+/// measure runs on `backend`; the rest, and everything without a backend, on the CPU.
+RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
+                              FeatureBackend& backend,
+                              const std::function<void(const std::string&)>& lap = {});
 RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               const std::function<void(const std::string&)>& lap = {});
 

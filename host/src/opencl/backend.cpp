@@ -24,6 +24,8 @@ constexpr std::size_t kPad = kPointPad;
 // Elements per work-item in the scan and reduction kernels.
 constexpr int kScanChunk = 256;
 constexpr int kSumChunk = 1024;
+// The crease kernel brackets its quantile to this fraction of the radius (2 um at 10 mm).
+constexpr float kCreaseTolerance = 2e-4f;
 
 // The kernels' Grid (kernels/neighbors.cl), passed as its seven kernel arguments.
 struct GridArgs {
@@ -145,6 +147,29 @@ class OpenClBackend final : public FeatureBackend {
       }
       const cl::Buffer d = compute_descriptor(f, n, radius, u_b);
       download(f, {{&d, &out}});
+      return out;
+    });
+  }
+
+  CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) override {
+    return guarded([&] {
+      CreaseMeasure out;
+      out.normals.resize(cloud.size());
+      out.concavity.assign(cloud.size(), NAN);
+      if (cloud.size() == 0) return out;
+      // The grid search whatever the cloud's shape: the measure's ball (10 mm) would be a
+      // window of hundreds of pixels.
+      const Frame f = upload(cloud, params.radius, true);
+      const Vec3Buffers n = search_buffers(f);
+      const cl::Buffer c = nan_buffer(f.queries());
+      const Eigen::Vector3f& vp = cloud.viewpoint;
+      launch("crease_grid", search_items(f), f.sx, f.sy, f.sz, f.count, f.slot_start, f.grid,
+             params.radius, params.own_radius, params.quantile, params.min_neighbors,
+             kCreaseTolerance * params.radius, vp.x(), vp.y(), vp.z(), n.x, n.y, n.z, c);
+      download(f, {{&n.x, &out.normals.x},
+                   {&n.y, &out.normals.y},
+                   {&n.z, &out.normals.z},
+                   {&c, &out.concavity}});
       return out;
     });
   }
@@ -279,7 +304,8 @@ class OpenClBackend final : public FeatureBackend {
     return {nan_buffer(m), nan_buffer(m), nan_buffer(m)};
   }
 
-  Frame upload(const Cloud& cloud, float radius) {
+  // `grid`: the grid search even for a pinhole frame.
+  Frame upload(const Cloud& cloud, float radius, bool grid = false) {
     // Kernels index with 32-bit ints, and the grid table holds 2 slots per point.
     if (cloud.size() >= (std::size_t{1} << 30)) {
       throw InternalError("the OpenCL backend takes at most 2^30 points per cloud");
@@ -289,7 +315,7 @@ class OpenClBackend final : public FeatureBackend {
     f.x = padded(cloud.x);
     f.y = padded(cloud.y);
     f.z = padded(cloud.z);
-    if (cloud.organized() && search_ != "grid") {
+    if (cloud.organized() && search_ != "grid" && !grid) {
       const FrameIntrinsics k = estimate_intrinsics(cloud);
       if (k.pinhole) {
         f.organized = true;
