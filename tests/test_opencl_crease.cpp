@@ -167,9 +167,9 @@ TEST(OpenClCrease, OneLanePerWorkItemAsOnGpus) {
                        robust_crease_params(), "VW=1");
 }
 
-// A plane with noise, two isolated points, NaN points and a ball larger than the cloud: the
-// isolated points and the NaNs get NaN; with the ball over everything each point's heights
-// are the whole cloud's.
+// A plane with noise, two isolated points (one a kilometre away, which makes the grid a hash
+// table), NaN points and a ball larger than the cloud: the isolated points and the NaNs get
+// NaN; with the ball over everything each point's heights are the whole cloud's.
 TEST(OpenClCrease, EdgeCases) {
   REQUIRE_OPENCL(cl);
   std::mt19937 rng(9);
@@ -183,7 +183,7 @@ TEST(OpenClCrease, EdgeCases) {
     c.y[i] = u(rng);
     c.z[i] = 0.4f + 0.2f * c.x[i] + g(rng);
   }
-  c.x[10] = 1.0f;  // alone
+  c.x[10] = 1000.0f;  // alone
   c.x[20] = -1.0f;
   for (std::size_t i = 30; i < 40; ++i) c.z[i] = NAN;
   CreaseParams p;
