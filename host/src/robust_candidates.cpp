@@ -43,6 +43,15 @@ void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items) {
   }
 }
 
+// Where the voxel grid's planes lie, in cells from the origin. A depth camera quantizes depth
+// (a D415 to 1 mm by default, 0.1 mm optionally), and a camera-frame cloud's z then sits
+// exactly on the planes of a grid of 1 mm through the origin: which voxel a point falls in is
+// decided by float rounding, half of them each way, and a change of depth far below the
+// quantum (+-0.5 um, or a transform's rounding) moves half the points to the next voxel and
+// changes the candidates, the nodes and the trajectory. Shifted by 0.45 cell, the planes lie
+// 0.45 mm from every 1 mm level and 0.05 mm from every 0.1 mm level.
+constexpr double kGridShift = 0.45;
+
 // The valid points keyed by voxel: the voxel's index in the box of voxels around the cloud
 // (x fastest, then y, then z), so that key order is spatial order and keys stay small.
 std::vector<std::pair<std::uint64_t, std::uint32_t>> voxel_keys(const Cloud& cloud,
@@ -56,9 +65,9 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> voxel_keys(const Cloud& clo
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!cloud.valid(i)) continue;
     const std::array<std::int64_t, 3> c{
-        static_cast<std::int64_t>(std::floor(cloud.x[i] * inv_cell)),
-        static_cast<std::int64_t>(std::floor(cloud.y[i] * inv_cell)),
-        static_cast<std::int64_t>(std::floor(cloud.z[i] * inv_cell))};
+        static_cast<std::int64_t>(std::floor(cloud.x[i] * inv_cell + kGridShift)),
+        static_cast<std::int64_t>(std::floor(cloud.y[i] * inv_cell + kGridShift)),
+        static_cast<std::int64_t>(std::floor(cloud.z[i] * inv_cell + kGridShift))};
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], c[a]);
       hi[a] = std::max(hi[a], c[a]);
