@@ -11,6 +11,7 @@
 
 #include "neighbor_grid.hpp"
 #include "robust_bins.hpp"
+#include "robust_stations.hpp"
 
 namespace groovetrace {
 namespace {
@@ -607,7 +608,9 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
   // flat, which moves its rim out and the root towards the other wall by up to a millimetre.
   bool symmetric = false;
   for (int pass = 0; pass < 2; ++pass) {
-    SeamCurve curve = smooth_curve(ordered, closed, p.smooth, p.station, normals);
+    // Sampled finely, then at stations anchored to the frame (robust_stations.hpp).
+    const SeamCurve curve = anchored_stations(
+        smooth_curve(ordered, closed, p.smooth, 0.25 * p.station, normals), p.station);
     if (curve.points.size() < 2) break;
     std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, symmetric);
     reject_inconsistent(raw);
