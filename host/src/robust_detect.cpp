@@ -18,6 +18,9 @@ namespace {
 
 // The shape window against the root's (see smooth_sections).
 constexpr double kShapeWindow = 5.0;
+// The weight of the curve's own point in the root's mean (see smooth_sections): a fit's
+// tricube weight at 0.75 of the window; a full window of fits weighs about 4.6.
+constexpr double kPriorWeight = 0.2;
 
 double tukey(double r, double c) {
   const double t = r / c;
@@ -238,30 +241,43 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
   std::vector<double> ds, w;
   for (std::size_t k = 0; k < raw.size(); ++k) {
     GrooveSection s = raw[k];
-    // Root: from the ok fits within h; where there are too few (corners, dropouts) the curve,
-    // which the previous pass built from ok fits only and which meets at corners where the
-    // legs' lines do.
-    s.root = curve.points[k];
+    // Root: each ok fit within h gives its offset from its own station, across the seam and in
+    // depth (a root lies in its station's plane); the root is the station plus their weighted
+    // mean. The curve carries the seam's course, so the offsets change slowly, and a mean does
+    // not extrapolate: a line fitted to the roots beside a run of failed fits had all of its
+    // support on one side, and one fit more or less there (a micrometre of input) tipped it by
+    // up to 3 mm. The curve itself - the previous pass's smoothed roots, meeting at corners
+    // where the legs' lines do - enters as one more offset (zero) with the weight of a fit
+    // kPriorWeight windows away: where fits fail the root slides to the curve as their weight
+    // fades, instead of jumping to it when fewer than three remain.
     neighbours(raw, k, curve, h, true, near, ds, w);
-    if (near.size() >= 3) {
-      std::vector<V3> roots;
-      for (std::size_t j : near) roots.push_back(raw[j].root);
-      const V3 r0 = local_linear<3>(roots, ds, w);
-      // Tukey reweighting on the residual across the seam (stations sit at different places
-      // along it).
-      std::vector<double> res(near.size());
+    std::vector<Eigen::Vector2d> off(near.size());
+    for (std::size_t q = 0; q < near.size(); ++q) {
+      const GrooveSection& r = raw[near[q]];
+      const V3 d = r.root - curve.points[near[q]];
+      off[q] = Eigen::Vector2d(d.dot(r.across()), d.dot(r.normal));
+    }
+    auto mean_offset = [&] {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      double sw = kPriorWeight;
       for (std::size_t q = 0; q < near.size(); ++q) {
-        V3 e = roots[q] - r0;
-        e -= e.dot(raw[k].tangent) * raw[k].tangent;
-        res[q] = e.norm();
+        sum += w[q] * off[q];
+        sw += w[q];
       }
+      return Eigen::Vector2d(sum / sw);
+    };
+    const Eigen::Vector2d o0 = mean_offset();
+    if (near.size() >= 3) {
+      // One Tukey reweighting: a fit that caught something else must not drag its neighbours.
+      std::vector<double> res(near.size());
+      for (std::size_t q = 0; q < near.size(); ++q) res[q] = (off[q] - o0).norm();
       std::vector<double> sorted = res;
       std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
       const double c = std::max(4.685 * 1.4826 * sorted[sorted.size() / 2], 1e-4);
       for (std::size_t q = 0; q < near.size(); ++q) w[q] *= tukey(res[q], c);
-      const V3 r = local_linear<3>(roots, ds, w);
-      if (r.allFinite()) s.root = r;
     }
+    const Eigen::Vector2d o = mean_offset();
+    s.root = curve.points[k] + o[0] * raw[k].across() + o[1] * raw[k].normal;
     // Shape.
     bool have_shape = false;
     for (double win = kShapeWindow * h; win <= 4 * kShapeWindow * h + 1e-12 && !have_shape;
