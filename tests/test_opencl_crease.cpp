@@ -247,8 +247,11 @@ TEST(OpenClCrease, RobustRunsAgree) {
         d.push_back(path_distance(to->trajectory, w.position));
       }
       std::sort(d.begin(), d.end());
-      EXPECT_LT(d[d.size() * 9 / 10], 2.5e-4) << shape_name(shape);
-      EXPECT_LT(d.back(), 1e-3) << shape_name(shape);
+      // The backends' concavities differ by ~1 um; the seam's fits are chaotic in where
+      // their stations lie (tens of micrometres move a 640x480 fit by tenths of a
+      // millimetre), so what remains is what reaches the stations: 0.04 / 0.16 mm here.
+      EXPECT_LT(d[d.size() * 9 / 10], 1e-4) << shape_name(shape);
+      EXPECT_LT(d.back(), 2.5e-4) << shape_name(shape);
     }
     std::size_t same = 0;
     for (std::size_t i = 0; i < scan.size(); ++i) {

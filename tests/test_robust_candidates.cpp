@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <groovetrace/robust.hpp>
+#include <random>
 
 #include "robust_scenes.hpp"
 
@@ -59,6 +60,34 @@ TEST(RobustCandidates, ThresholdFollowsTheScansNoise) {
   // Relative to the noise the threshold is the same rule: median + k sigma (or the floor).
   const RobustParams p;
   EXPECT_NEAR(b.threshold, b.median + std::max(p.threshold_k * b.sigma, 0.01 * p.scale), 1e-9);
+}
+
+TEST(RobustCandidates, DepthOnMillimetreLevelsKeepsItsVoxels) {
+  // A camera-frame plane whose depths are quantized to 1 mm (a D415's depth unit): +-0.5 um
+  // more depth must leave every voxel as it was (with the voxel grid's planes on the 1 mm
+  // levels, float rounding put half the points in the voxel below, and the noise moved them).
+  Cloud c, moved;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> tiny(-0.5e-6f, 0.5e-6f);
+  for (int row = 0; row < 120; ++row) {
+    for (int col = 0; col < 160; ++col) {
+      const double x = (col - 80) * 0.0006, y = (row - 60) * 0.0006;
+      const float z = static_cast<float>(std::round((0.4 + 0.2 * x + 0.05 * y) * 1000) / 1000);
+      c.x.push_back(static_cast<float>(x));
+      c.y.push_back(static_cast<float>(y));
+      c.z.push_back(z);
+      moved.x.push_back(static_cast<float>(x));
+      moved.y.push_back(static_cast<float>(y));
+      moved.z.push_back(z + tiny(rng));
+    }
+  }
+  c.width = moved.width = static_cast<std::uint32_t>(c.x.size());
+  const CreaseMap a = crease_map(c, RobustParams{});
+  const CreaseMap b = crease_map(moved, RobustParams{});
+  ASSERT_EQ(a.points.size(), b.points.size());
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) same += a.voxel[i] == b.voxel[i] ? 1 : 0;
+  EXPECT_EQ(same, c.size());
 }
 
 }  // namespace

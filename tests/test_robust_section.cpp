@@ -224,5 +224,39 @@ TEST(RobustSection, SectionIn3DMapsTheProfileBack) {
   EXPECT_NEAR(s.across().x(), -1.0, 1e-6);
 }
 
+TEST(RobustSection, ThinningDoesNotHangOnOnePointMore) {
+  // A slab of ~1400 points (more than the fit takes): one point more at the far end of the
+  // slab, outside the window, must not change which points the fit sees (every k-th point of
+  // the list was a new subset each time the list grew by one).
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss(0.0, 0.0004);
+  Cloud c;
+  for (double y = -0.0015; y <= 0.0015; y += 0.0003) {
+    for (const auto& p : v_profile(0.008, 60, 60, 0.001, 0.0, 1, 0.0003, 1)) {
+      c.x.push_back(static_cast<float>(p.x()));
+      c.y.push_back(static_cast<float>(y));
+      c.z.push_back(static_cast<float>(p.y() + gauss(rng)));
+    }
+  }
+  c.width = static_cast<std::uint32_t>(c.x.size());
+  auto fit = [](const Cloud& cloud) {
+    std::vector<std::uint32_t> all(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+    return fit_section(cloud, all, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 1, 0),
+                       Eigen::Vector3d(0, 0, 1), 0.0015, 0.02);
+  };
+  const GrooveSection a = fit(c);
+  ASSERT_GT(a.support, 1000);
+  ASSERT_TRUE(a.ok) << a.why;
+  Cloud more = c;
+  more.x.push_back(0.025f);  // beyond the window
+  more.y.push_back(0.0f);
+  more.z.push_back(0.0f);
+  more.width = static_cast<std::uint32_t>(more.x.size());
+  const GrooveSection b = fit(more);
+  ASSERT_TRUE(b.ok) << b.why;
+  EXPECT_LT((a.root - b.root).norm(), 1e-5);
+}
+
 }  // namespace
 }  // namespace groovetrace
