@@ -1,8 +1,11 @@
-// Builds the hashed uniform grid of an unorganized cloud by counting sort: count the points
-// of each slot, scan the counts into slot starts, scatter the points into slot order, then sort
-// each slot by input index so that the result (and every sum over it) is deterministic.
-// No local memory and no work-group size assumptions: each work-item owns whole chunks.
-// Point arrays (input and sorted order alike) carry PAD elements before point 0.
+// Builds the hashed uniform grid of an unorganized cloud: the valid points sorted by grid slot
+// and, within a slot, by input index, so that the result (and every sum over it) is
+// deterministic. Two stable counting-sort passes keep the scattered writes inside the cache
+// however large the cloud: grid_partition groups the points into up to a thousand buckets of
+// consecutive slots (each chunk of input appends to every bucket as a stream), then
+// grid_bucket_sort sorts each bucket, a range that fits in the cache, by slot.
+// No local memory, no atomics and no work-group size assumptions: each work-item owns whole
+// chunks or buckets. Point arrays in input and sorted order carry PAD elements before point 0.
 
 // Bounding box of the valid points, per chunk of `chunk` points: partial[6 g ..] = min x, y,
 // z, max x, y, z (+-inf for a chunk without valid points); the host combines the chunks.
@@ -23,21 +26,42 @@ __kernel void bounds(__global const float* xs, __global const float* ys, __globa
   vstore3(hi, 2 * g + 1, partial);
 }
 
-// Counts the valid points of each slot; point_slot[i] = slot of point i (UINT_MAX: invalid).
-__kernel void grid_count(__global const float* xs, __global const float* ys,
-                         __global const float* zs, int n, GRID_PARAMS,
-                         __global volatile uint* counts, __global uint* point_slot) {
+// Slot of a point (UINT_MAX: not a valid point).
+inline uint point_slot(const Grid* g, float x, float y, float z) {
+  if (!(isfinite(x) && isfinite(y) && isfinite(z))) return UINT_MAX;
+  return cell_slot(g, cell_of(x, g->inv_cell), cell_of(y, g->inv_cell), cell_of(z, g->inv_cell));
+}
+
+// Per chunk c of `chunk` input points, the valid points of each bucket (slots s with
+// s >> bucket_shift == b): counts[c * buckets + b], a chunk's row contiguous.
+__kernel void grid_partition_count(__global const float* xs, __global const float* ys,
+                                   __global const float* zs, int n, int chunk, GRID_PARAMS,
+                                   int bucket_shift, int buckets, __global uint* counts) {
   const Grid g = GRID_FROM_PARAMS;
-  const int i = get_global_id(0);
-  if (i >= n) return;
-  const float x = xs[PAD + i], y = ys[PAD + i], z = zs[PAD + i];
-  if (!(isfinite(x) && isfinite(y) && isfinite(z))) {
-    point_slot[i] = UINT_MAX;
-    return;
+  const int c = get_global_id(0);
+  const int begin = c * chunk;
+  if (begin >= n) return;
+  __global uint* row = counts + (size_t)c * buckets;
+  for (int b = 0; b < buckets; ++b) row[b] = 0;
+  for (int i = begin; i < min(begin + chunk, n); ++i) {
+    const uint slot = point_slot(&g, xs[PAD + i], ys[PAD + i], zs[PAD + i]);
+    if (slot != UINT_MAX) ++row[slot >> bucket_shift];
   }
-  const uint slot = cell_slot(&g, cell_of(x, inv_cell), cell_of(y, inv_cell), cell_of(z, inv_cell));
-  point_slot[i] = slot;
-  atomic_inc(&counts[slot]);
+}
+
+// Per bucket b, over the chunks' rows: counts[c * buckets + b] becomes the bucket's points
+// in the chunks before c, and totals[b] the bucket's size.
+__kernel void partition_offsets(__global uint* counts, int chunks, int buckets,
+                                __global uint* totals) {
+  const int b = get_global_id(0);
+  if (b >= buckets) return;
+  uint s = 0;
+  for (int c = 0; c < chunks; ++c) {
+    const uint v = counts[(size_t)c * buckets + b];
+    counts[(size_t)c * buckets + b] = s;
+    s += v;
+  }
+  totals[b] = s;
 }
 
 // Sum of each chunk of `chunk` elements of in[0, n).
@@ -81,48 +105,62 @@ __kernel void scan_chunk_apply(__global const uint* in, int n, int chunk,
   if (end == n) out[n] = s;
 }
 
-// Puts each valid point into its slot's range (in arbitrary order within the slot).
-__kernel void grid_scatter(__global const float* xs, __global const float* ys,
-                           __global const float* zs, int n, __global const uint* point_slot,
-                           __global const uint* slot_start, __global volatile uint* fill,
-                           __global float* sorted_x, __global float* sorted_y,
-                           __global float* sorted_z, __global int* order) {
-  const int i = get_global_id(0);
-  if (i >= n) return;
-  const uint slot = point_slot[i];
-  if (slot == UINT_MAX) return;
-  const uint k = slot_start[slot] + atomic_inc(&fill[slot]);
-  sorted_x[PAD + k] = xs[PAD + i];
-  sorted_y[PAD + k] = ys[PAD + i];
-  sorted_z[PAD + k] = zs[PAD + i];
-  order[k] = i;
+// Appends each chunk's valid points, in input order, to their buckets: partitioned[t] = (x, y,
+// z, input index bits). bucket_start: the scanned bucket sizes; offsets: partition_offsets's,
+// advanced as the chunk's points are placed.
+__kernel void grid_partition(__global const float* xs, __global const float* ys,
+                             __global const float* zs, int n, int chunk, GRID_PARAMS,
+                             int bucket_shift, int buckets, __global const uint* bucket_start,
+                             __global uint* offsets, __global float4* partitioned) {
+  const Grid g = GRID_FROM_PARAMS;
+  const int c = get_global_id(0);
+  const int begin = c * chunk;
+  if (begin >= n) return;
+  __global uint* row = offsets + (size_t)c * buckets;
+  for (int i = begin; i < min(begin + chunk, n); ++i) {
+    const float x = xs[PAD + i], y = ys[PAD + i], z = zs[PAD + i];
+    const uint slot = point_slot(&g, x, y, z);
+    if (slot == UINT_MAX) continue;
+    const uint b = slot >> bucket_shift;
+    partitioned[bucket_start[b] + row[b]++] = (float4)(x, y, z, as_float(i));
+  }
 }
 
-// Sorts each slot's range by input index (insertion sort: slots hold tens of points).
-__kernel void grid_sort_slots(__global const uint* slot_start, int table_size,
-                              __global float* sorted_x, __global float* sorted_y,
-                              __global float* sorted_z, __global int* order) {
-  const int s = get_global_id(0);
-  if (s >= table_size) return;
-  sorted_x += PAD;
-  sorted_y += PAD;
-  sorted_z += PAD;
-  const int begin = (int)slot_start[s], end = (int)slot_start[s + 1];
-  for (int k = begin + 1; k < end; ++k) {
-    const int key = order[k];
-    const float x = sorted_x[k], y = sorted_y[k], z = sorted_z[k];
-    int j = k - 1;
-    while (j >= begin && order[j] > key) {
-      order[j + 1] = order[j];
-      sorted_x[j + 1] = sorted_x[j];
-      sorted_y[j + 1] = sorted_y[j];
-      sorted_z[j + 1] = sorted_z[j];
-      --j;
-    }
-    order[j + 1] = key;
-    sorted_x[j + 1] = x;
-    sorted_y[j + 1] = y;
-    sorted_z[j + 1] = z;
+// Counting sort of each bucket by slot, stable, so each slot's points stay in input order:
+// writes the bucket's slot_start entries (the last bucket also slot_start[table_size]), the
+// sorted points and order[k] = input index of sorted point k. slot_fill: scratch, one per slot.
+__kernel void grid_bucket_sort(__global const float4* partitioned,
+                               __global const uint* bucket_start, GRID_PARAMS, int bucket_shift,
+                               int buckets, int table_size, __global uint* slot_fill,
+                               __global uint* slot_start, __global float* sorted_x,
+                               __global float* sorted_y, __global float* sorted_z,
+                               __global int* order) {
+  const Grid g = GRID_FROM_PARAMS;
+  const int b = get_global_id(0);
+  if (b >= buckets) return;
+  const int s_begin = b << bucket_shift;
+  const int s_end = min((b + 1) << bucket_shift, table_size);
+  const uint t_begin = bucket_start[b], t_end = bucket_start[b + 1];
+  for (int s = s_begin; s < s_end; ++s) slot_fill[s] = 0;
+  for (uint t = t_begin; t < t_end; ++t) {
+    const float4 p = partitioned[t];
+    ++slot_fill[point_slot(&g, p.x, p.y, p.z)];
+  }
+  uint k = t_begin;
+  for (int s = s_begin; s < s_end; ++s) {
+    const uint size = slot_fill[s];
+    slot_start[s] = k;
+    slot_fill[s] = k;
+    k += size;
+  }
+  if (b == buckets - 1) slot_start[table_size] = k;
+  for (uint t = t_begin; t < t_end; ++t) {
+    const float4 p = partitioned[t];
+    const uint at = slot_fill[point_slot(&g, p.x, p.y, p.z)]++;
+    sorted_x[PAD + at] = p.x;
+    sorted_y[PAD + at] = p.y;
+    sorted_z[PAD + at] = p.z;
+    order[at] = as_int(p.w);
   }
 }
 

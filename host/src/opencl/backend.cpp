@@ -1,10 +1,12 @@
 // The OpenCL backend: uploads a cloud, sets up its neighbour search (pixel windows for pinhole
 // frames, a hashed grid built on the device otherwise) and runs the kernels of kernels/*.cl.
 // Results come back in input order, as the CPU reference returns them. Environment, for
-// experiments: GROOVETRACE_OPENCL_PROFILE (kernel times on stderr), GROOVETRACE_OPENCL_SEARCH=grid
-// (grid search for organized frames too), GROOVETRACE_OPENCL_VW and GROOVETRACE_OPENCL_OPTIONS
-// (see device_program.cpp).
+// experiments: GROOVETRACE_OPENCL_PROFILE (kernel times and the host side of grid downloads on
+// stderr), GROOVETRACE_OPENCL_SEARCH=grid (grid search for organized frames too),
+// GROOVETRACE_OPENCL_VW and GROOVETRACE_OPENCL_OPTIONS (see device_program.cpp).
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -24,6 +26,13 @@ constexpr std::size_t kPad = kPointPad;
 // Elements per work-item in the scan and reduction kernels.
 constexpr int kScanChunk = 256;
 constexpr int kSumChunk = 1024;
+// The grid build's partition: at most this many buckets of consecutive slots (the streams a
+// chunk of input appends to; a 16M-point cloud's bucket, about 0.6 MB, stays in a core's cache
+// while it is sorted), and at most this many chunks of input, each a work-item (enough work
+// groups to occupy a CPU's cores), of at least kMinChunk points.
+constexpr std::uint32_t kMaxBuckets = 1024;
+constexpr std::size_t kMaxChunks = 512;
+constexpr std::size_t kMinChunk = 1024;
 // The crease kernel brackets its quantile to this fraction of the radius (2 um at 10 mm).
 constexpr float kCreaseTolerance = 2e-4f;
 
@@ -254,7 +263,8 @@ class OpenClBackend final : public FeatureBackend {
     if (profile_) profiled_.emplace_back(name, done);
   }
 
-  // GROOVETRACE_OPENCL_PROFILE set: each kernel's device time on stderr after every call.
+  // GROOVETRACE_OPENCL_PROFILE set: each kernel's device time, then each grid download's host
+  // time, on stderr after every call.
   void print_profile() {
     queue_.finish();
     for (const auto& [name, event] : profiled_) {
@@ -264,6 +274,10 @@ class OpenClBackend final : public FeatureBackend {
       std::fprintf(stderr, "groovetrace: opencl %-22s %9.2f ms\n", name.c_str(), ms);
     }
     profiled_.clear();
+    for (const auto& [name, ms] : host_profiled_) {
+      std::fprintf(stderr, "groovetrace: opencl %-22s %9.2f ms\n", name.c_str(), ms);
+    }
+    host_profiled_.clear();
   }
 
   cl::Buffer buffer(std::size_t elements, std::size_t element_size = sizeof(float)) {
@@ -328,8 +342,6 @@ class OpenClBackend final : public FeatureBackend {
       }
     }
     build_grid(f, radius);
-    // The search walks the sorted copy; the input order is only needed to build it.
-    f.x = f.y = f.z = cl::Buffer();
     return f;
   }
 
@@ -388,28 +400,44 @@ class OpenClBackend final : public FeatureBackend {
     return table;
   }
 
-  // Counting sort of the valid points into the cells of edge `cell` (m).
+  // Sorts the valid points by the slots of the cells of edge `cell` (m) in two stable counting
+  // sorts (kernels/grid_build.cl): into buckets of consecutive slots, then each bucket by slot.
   void build_grid(Frame& f, float cell) {
     const std::uint32_t table = plan_grid(f, cell);
-    const cl::Buffer counts = buffer(table, sizeof(cl_uint));
-    queue_.enqueueFillBuffer(counts, cl_uint(0), 0, table * sizeof(cl_uint));
-    const cl::Buffer point_slot = buffer(f.n, sizeof(cl_uint));
-    launch("grid_count", f.n, f.x, f.y, f.z, as_int(f.n), f.grid, counts, point_slot);
-    f.slot_start = buffer(table + 1, sizeof(cl_uint));
-    scan(counts, table, f.slot_start);
+    int bucket_shift = 0;
+    while (((table - 1) >> bucket_shift) + 1 > kMaxBuckets) ++bucket_shift;
+    const std::uint32_t buckets = ((table - 1) >> bucket_shift) + 1;
+    const std::size_t chunks =
+        std::clamp<std::size_t>((f.n + kMinChunk - 1) / kMinChunk, 1, kMaxChunks);
+    const int chunk = as_int((f.n + chunks - 1) / chunks);
+    const cl::Buffer offsets = buffer(chunks * buckets, sizeof(cl_uint));
+    launch("grid_partition_count", chunks, f.x, f.y, f.z, as_int(f.n), chunk, f.grid, bucket_shift,
+           as_int(buckets), offsets);
+    const cl::Buffer totals = buffer(buckets, sizeof(cl_uint));
+    launch("partition_offsets", buckets, offsets, as_int(chunks), as_int(buckets), totals);
+    const cl::Buffer bucket_start = buffer(buckets + 1, sizeof(cl_uint));
+    scan(totals, buckets, bucket_start);
     cl_uint count = 0;
-    queue_.enqueueReadBuffer(f.slot_start, CL_TRUE, table * sizeof(cl_uint), sizeof(cl_uint),
+    queue_.enqueueReadBuffer(bucket_start, CL_TRUE, buckets * sizeof(cl_uint), sizeof(cl_uint),
                              &count);
     f.count = static_cast<int>(count);
-    // The counts become the per-slot fill level of the scatter.
-    queue_.enqueueFillBuffer(counts, cl_uint(0), 0, table * sizeof(cl_uint));
+    const cl::Buffer partitioned = buffer(count, sizeof(cl_float4));
+    launch("grid_partition", chunks, f.x, f.y, f.z, as_int(f.n), chunk, f.grid, bucket_shift,
+           as_int(buckets), bucket_start, offsets, partitioned);
+    // The search walks the sorted copy; the input order is only needed to build it. The driver
+    // frees a buffer once the commands using it are done: waiting for them keeps the input,
+    // the partitioned copy and the sorted copy from being held all at once.
+    f.x = f.y = f.z = cl::Buffer();
+    queue_.finish();
+    const cl::Buffer slot_fill = buffer(table, sizeof(cl_uint));
+    f.slot_start = buffer(table + 1, sizeof(cl_uint));
     f.sx = nan_buffer(count);
     f.sy = nan_buffer(count);
     f.sz = nan_buffer(count);
     f.order = buffer(count, sizeof(cl_int));
-    launch("grid_scatter", f.n, f.x, f.y, f.z, as_int(f.n), point_slot, f.slot_start, counts, f.sx,
-           f.sy, f.sz, f.order);
-    launch("grid_sort_slots", table, f.slot_start, as_int(table), f.sx, f.sy, f.sz, f.order);
+    launch("grid_bucket_sort", buckets, partitioned, bucket_start, f.grid, bucket_shift,
+           as_int(buckets), as_int(table), slot_fill, f.slot_start, f.sx, f.sy, f.sz, f.order);
+    queue_.finish();
   }
 
   Vec3Buffers compute_normals(const Frame& f, const Eigen::Vector3f& vp, float radius,
@@ -477,6 +505,8 @@ class OpenClBackend final : public FeatureBackend {
       return;
     }
     if (f.count == 0) return;
+    if (profile_) queue_.finish();  // the kernels before are not the download's time
+    const auto start = std::chrono::steady_clock::now();
     const std::size_t count = static_cast<std::size_t>(f.count);
     const int* order = static_cast<const int*>(
         queue_.enqueueMapBuffer(f.order, CL_TRUE, CL_MAP_READ, 0, count * sizeof(int)));
@@ -489,6 +519,10 @@ class OpenClBackend final : public FeatureBackend {
     }
     queue_.enqueueUnmapMemObject(f.order, const_cast<int*>(order));
     queue_.finish();
+    if (profile_) {
+      const std::chrono::duration<double, std::milli> ms = std::chrono::steady_clock::now() - start;
+      host_profiled_.emplace_back("download_host", ms.count());
+    }
   }
 
   struct Launchable {
@@ -502,6 +536,7 @@ class OpenClBackend final : public FeatureBackend {
   std::string search_;
   cl::CommandQueue queue_;
   std::vector<std::pair<std::string, cl::Event>> profiled_;
+  std::vector<std::pair<std::string, double>> host_profiled_;  // ms
   std::map<std::string, Launchable> kernels_;
 };
 
