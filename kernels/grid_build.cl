@@ -128,13 +128,14 @@ __kernel void grid_partition(__global const float* xs, __global const float* ys,
 
 // Counting sort of each bucket by slot, stable, so each slot's points stay in input order:
 // writes the bucket's slot_start entries (the last bucket also slot_start[table_size]), the
-// sorted points and order[k] = input index of sorted point k. slot_fill: scratch, one per slot.
+// sorted points and order[k] = input index of sorted point k. Scratch: slot_fill, one per slot,
+// and partitioned_slot, one per point.
 __kernel void grid_bucket_sort(__global const float4* partitioned,
                                __global const uint* bucket_start, GRID_PARAMS, int bucket_shift,
                                int buckets, int table_size, __global uint* slot_fill,
-                               __global uint* slot_start, __global float* sorted_x,
-                               __global float* sorted_y, __global float* sorted_z,
-                               __global int* order) {
+                               __global uint* partitioned_slot, __global uint* slot_start,
+                               __global float* sorted_x, __global float* sorted_y,
+                               __global float* sorted_z, __global int* order) {
   const Grid g = GRID_FROM_PARAMS;
   const int b = get_global_id(0);
   if (b >= buckets) return;
@@ -144,7 +145,9 @@ __kernel void grid_bucket_sort(__global const float4* partitioned,
   for (int s = s_begin; s < s_end; ++s) slot_fill[s] = 0;
   for (uint t = t_begin; t < t_end; ++t) {
     const float4 p = partitioned[t];
-    ++slot_fill[point_slot(&g, p.x, p.y, p.z)];
+    const uint slot = point_slot(&g, p.x, p.y, p.z);
+    partitioned_slot[t] = slot;
+    ++slot_fill[slot];
   }
   uint k = t_begin;
   for (int s = s_begin; s < s_end; ++s) {
@@ -156,7 +159,7 @@ __kernel void grid_bucket_sort(__global const float4* partitioned,
   if (b == buckets - 1) slot_start[table_size] = k;
   for (uint t = t_begin; t < t_end; ++t) {
     const float4 p = partitioned[t];
-    const uint at = slot_fill[point_slot(&g, p.x, p.y, p.z)]++;
+    const uint at = slot_fill[partitioned_slot[t]]++;
     sorted_x[PAD + at] = p.x;
     sorted_y[PAD + at] = p.y;
     sorted_z[PAD + at] = p.z;

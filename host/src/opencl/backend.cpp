@@ -430,13 +430,15 @@ class OpenClBackend final : public FeatureBackend {
     f.x = f.y = f.z = cl::Buffer();
     queue_.finish();
     const cl::Buffer slot_fill = buffer(table, sizeof(cl_uint));
+    const cl::Buffer partitioned_slot = buffer(count, sizeof(cl_uint));
     f.slot_start = buffer(table + 1, sizeof(cl_uint));
     f.sx = nan_buffer(count);
     f.sy = nan_buffer(count);
     f.sz = nan_buffer(count);
     f.order = buffer(count, sizeof(cl_int));
     launch("grid_bucket_sort", buckets, partitioned, bucket_start, f.grid, bucket_shift,
-           as_int(buckets), as_int(table), slot_fill, f.slot_start, f.sx, f.sy, f.sz, f.order);
+           as_int(buckets), as_int(table), slot_fill, partitioned_slot, f.slot_start, f.sx, f.sy,
+           f.sz, f.order);
     queue_.finish();
   }
 
