@@ -51,7 +51,9 @@ class OpenClError : public InternalError {
 std::size_t opencl_program_builds();
 
 /// Bytes of OpenCL buffers held by this process's backends: now, and at most at once since the
-/// last reset (a diagnostic for memory per point; host arrays not included).
+/// last reset (a diagnostic for memory per point; host arrays not included). On a CPU device
+/// the memory of released buffers is kept for later calls, up to 2 GiB per process, and not
+/// counted here: a batch of large clouds then skips the OS's page zeroing on every call.
 struct OpenClMemory {
   std::uint64_t current = 0, peak = 0;
 };

@@ -18,6 +18,7 @@
 #include "cl_api.hpp"
 #include "device_program.hpp"
 #include "frame_intrinsics.hpp"
+#include "host_blocks.hpp"
 
 namespace groovetrace::ocl {
 namespace {
@@ -73,13 +74,23 @@ struct Vec3Buffers {
 // through a destructor callback, which the driver may call from its own thread.
 std::atomic<std::uint64_t> g_buffer_bytes{0}, g_buffer_peak{0};
 
-void CL_CALLBACK buffer_released(cl_mem, void* bytes) {
-  g_buffer_bytes -= reinterpret_cast<std::uintptr_t>(bytes);
+// What a buffer's release gives back: its bytes, and its host block when it has one.
+struct Allocation {
+  std::size_t bytes = 0;
+  void* host = nullptr;
+  std::size_t capacity = 0;
+};
+
+void CL_CALLBACK buffer_released(cl_mem, void* data) {
+  const Allocation* a = static_cast<const Allocation*>(data);
+  g_buffer_bytes -= a->bytes;
+  if (a->host != nullptr) give_host_block(a->host, a->capacity);
+  delete a;
 }
 
-void buffer_allocated(cl::Buffer& b, std::size_t bytes) {
-  b.setDestructorCallback(buffer_released, reinterpret_cast<void*>(std::uintptr_t{bytes}));
-  const std::uint64_t now = g_buffer_bytes += bytes;
+void buffer_allocated(cl::Buffer& b, const Allocation& a) {
+  b.setDestructorCallback(buffer_released, new Allocation(a));
+  const std::uint64_t now = g_buffer_bytes += a.bytes;
   std::uint64_t peak = g_buffer_peak.load();
   while (now > peak && !g_buffer_peak.compare_exchange_weak(peak, now)) {
   }
@@ -100,7 +111,8 @@ class OpenClBackend final : public FeatureBackend {
         profile_(std::getenv("GROOVETRACE_OPENCL_PROFILE") != nullptr),
         search_(std::getenv("GROOVETRACE_OPENCL_SEARCH") ? std::getenv("GROOVETRACE_OPENCL_SEARCH")
                                                          : ""),
-        queue_(dp_->context, dp_->device, profile_ ? CL_QUEUE_PROFILING_ENABLE : 0) {}
+        queue_(dp_->context, dp_->device, profile_ ? CL_QUEUE_PROFILING_ENABLE : 0),
+        host_blocks_((dp_->device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0) {}
 
   std::string name() const override { return "opencl"; }
   std::string device() const override { return dp_->description; }
@@ -281,10 +293,22 @@ class OpenClBackend final : public FeatureBackend {
   }
 
   cl::Buffer buffer(std::size_t elements, std::size_t element_size = sizeof(float)) {
-    const std::size_t bytes = std::max<std::size_t>(elements, 1) * element_size;
-    cl::Buffer b(dp_->context, CL_MEM_READ_WRITE, bytes);
-    buffer_allocated(b, bytes);
-    return b;
+    Allocation a;
+    a.bytes = std::max<std::size_t>(elements, 1) * element_size;
+    if (!host_blocks_) {
+      cl::Buffer b(dp_->context, CL_MEM_READ_WRITE, a.bytes);
+      buffer_allocated(b, a);
+      return b;
+    }
+    a.host = take_host_block(a.bytes, &a.capacity);
+    try {
+      cl::Buffer b(dp_->context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, a.bytes, a.host);
+      buffer_allocated(b, a);
+      return b;
+    } catch (...) {
+      give_host_block(a.host, a.capacity);
+      throw;
+    }
   }
 
   // A device point array holding v.
@@ -540,6 +564,9 @@ class OpenClBackend final : public FeatureBackend {
   std::vector<std::pair<std::string, cl::Event>> profiled_;
   std::vector<std::pair<std::string, double>> host_profiled_;  // ms
   std::map<std::string, Launchable> kernels_;
+  // A CPU device's buffers live in recycled host blocks (host_blocks.hpp); a GPU's stay the
+  // driver's own device memory.
+  bool host_blocks_;
 };
 
 }  // namespace
