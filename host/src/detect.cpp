@@ -1,7 +1,7 @@
-#include <groovetrace/detect.hpp>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <groovetrace/detect.hpp>
 #include <numeric>
 
 #include "neighbor_grid.hpp"
@@ -51,26 +51,57 @@ int find_root(std::vector<int>& parent, int i) {
   }
   return i;
 }
+
+// The root of i in a forest that other threads link concurrently (path halving; a stale read
+// only costs a step).
+int find_root(std::vector<std::atomic<int>>& parent, int i) {
+  for (;;) {
+    const int p = parent[i].load(std::memory_order_relaxed);
+    if (p == i) return i;
+    const int g = parent[p].load(std::memory_order_relaxed);
+    int expected = p;
+    if (g != p) parent[i].compare_exchange_weak(expected, g, std::memory_order_relaxed);
+    i = g;
+  }
+}
+
+// Joins the sets of a and b; the root with the larger index is linked under the smaller, by a
+// compare-and-swap that fails (and retries) when another thread linked it first. Each set's
+// root is therefore its smallest index, whatever the order of the unions.
+void unite(std::vector<std::atomic<int>>& parent, int a, int b) {
+  for (;;) {
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a == b) return;
+    if (a < b) std::swap(a, b);
+    int expected = a;
+    if (parent[a].compare_exchange_strong(expected, b, std::memory_order_relaxed)) return;
+  }
+}
+
 }  // namespace
 
 Components connected_components(const Cloud& cloud, const std::vector<std::uint8_t>& mask,
-                                 float link_distance) {
+                                float link_distance) {
   const std::size_t n = cloud.size();
   Cloud masked = cloud;  // only masked points take part in the search
   for (std::size_t i = 0; i < n; ++i) {
     if (!mask[i]) masked.x[i] = NAN;
   }
   const NeighborGrid grid(masked, link_distance);
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::atomic<int>> linked(n);
+  for (std::size_t i = 0; i < n; ++i)
+    linked[i].store(static_cast<int>(i), std::memory_order_relaxed);
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(dynamic, 4096)
+  for (std::int64_t i = 0; i < count; ++i) {
     if (!masked.valid(i)) continue;
     grid.for_each_within(masked.point(i), link_distance, [&](std::uint32_t j, float) {
-      if (j >= i) return;
-      const int a = find_root(parent, static_cast<int>(i)), b = find_root(parent, j);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      if (j < i) unite(linked, static_cast<int>(i), static_cast<int>(j));
     });
   }
+  std::vector<int> parent(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = linked[i].load(std::memory_order_relaxed);
   std::vector<std::size_t> root_size(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (masked.valid(i)) ++root_size[find_root(parent, static_cast<int>(i))];
@@ -94,8 +125,8 @@ Components connected_components(const Cloud& cloud, const std::vector<std::uint8
   return out;
 }
 
-Detection detect_groove(const Cloud& cloud, const std::vector<float>& descriptor,
-                        double threshold, int min_component, float link_distance) {
+Detection detect_groove(const Cloud& cloud, const std::vector<float>& descriptor, double threshold,
+                        int min_component, float link_distance) {
   Detection det;
   det.threshold = std::isnan(threshold) ? otsu_threshold(descriptor) : threshold;
   const std::size_t n = cloud.size();
