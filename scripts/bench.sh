@@ -55,16 +55,22 @@ for method, backend in (("paper", "opencl"), ("paper", "cpu"), ("robust", "openc
                         ("robust", "cpu")):
     key = backend if method == "paper" else f"{method}-{backend}"
     cmd = [cli, "run", scan, "-o", f"{out}/cli-{key}", "--method", method, "--backend",
-           backend, "--quiet"]
-    subprocess.run(cmd, check=True)  # warm-up: PoCL's kernel cache, the file cache
-    times = []
+           backend]
+    subprocess.run(cmd, check=True, capture_output=True)  # warm-up: PoCL's cache, file cache
+    times, written = [], []
     for _ in range(5 if backend == "opencl" else 2):
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True)
+        run = subprocess.run(cmd, check=True, capture_output=True, text=True)
         times.append(time.perf_counter() - t0)
+        # Load to written outputs, inside the process: report.json's total (from the start of
+        # `run` to the start of writing) plus the write stage the CLI prints.
+        total = json.load(open(f"{out}/cli-{key}/report.json"))["timings_ms"]["total"]
+        write = [float(line.split()[2]) for line in run.stdout.splitlines()
+                 if line.startswith("groovetrace: write")]
+        written.append((total + write[0]) / 1000 if write else None)
     report = json.load(open(f"{out}/cli-{key}/report.json"))
-    result[key] = {"times_s": times, "device": report.get("device", ""), "method": method,
-                   "backend": backend,
+    result[key] = {"times_s": times, "written_s": written, "device": report.get("device", ""),
+                   "method": method, "backend": backend,
                    "timings_ms": report.get("timings_ms", report.get("timings", {}))}
 json.dump(result, open(f"{out}/cli.json", "w"), indent=1)
 EOF
@@ -205,29 +211,39 @@ for w in (640, 1280):
         targets.append(("end to end vs the PCL pipeline", 30.0, ratio(o, pc)))
 p()
 if cli:
-    p("The CLI, process start to exit (`groovetrace run FRAME.pcd -o DIR --method M "
-      "--backend B --quiet`, 1280x720 frame, after one warm-up run). `--method robust` is the "
-      "default run; its per-point stage (the crease measure) is the backend's, its seam fits "
-      "run on the CPU either way:")
+    p("The CLI on the 1280x720 frame (`groovetrace run FRAME.pcd -o DIR --method M --backend "
+      "B`, after one warm-up run). *Load to written* is the issue's measure: from the start of "
+      "`run` (before the scan is read and the OpenCL device is set up) to the outputs written, "
+      "in the process (report.json's total plus the write stage). *Process* adds the process's "
+      "start (loading PCL, VTK and the OpenCL driver's libraries) and exit. `--method robust` "
+      "is the default run; its per-point stage (the crease measure) is the backend's, its seam "
+      "fits run on the CPU either way:")
     p()
-    p("| method | backend | runs (s) | median (s) | stages (ms, from report.json) |")
-    p("|---|---|---|---:|---|")
+    p("| method | backend | load to written (s) | median | process (s) | median | stages (ms, from report.json) |")
+    p("|---|---|---|---:|---|---:|---|")
     for key, r in cli.items():
         stages = ", ".join(f"{k} {v:.0f}" for k, v in r["timings_ms"].items()) \
             if isinstance(r["timings_ms"], dict) else ""
+        w = [t for t in r.get("written_s", []) if t is not None]
         p(f"| {r.get('method', 'paper')} | {r.get('backend', key)} | "
+          f"{', '.join(f'{t:.2f}' for t in w)} | "
+          f"{statistics.median(w) if w else float('nan'):.2f} | "
           f"{', '.join(f'{t:.2f}' for t in r['times_s'])} | "
           f"{statistics.median(r['times_s']):.2f} | {stages} |")
     p()
-    med = statistics.median(cli["opencl"]["times_s"]) if "opencl" in cli else None
-    targets.append(("CLI end to end, --method paper, 1280x720 (s, at most)", 0.6, med))
+    w = [t for t in cli.get("opencl", {}).get("written_s", []) if t is not None]
+    targets.append(("CLI end to end, --method paper, 1280x720, load to written outputs (s, at "
+                    "most)", 0.6, statistics.median(w) if w else None))
+    if "opencl" in cli:
+        targets.append(("the same, process start to exit (s, at most)", 0.6,
+                        statistics.median(cli["opencl"]["times_s"])))
 
 p("## Targets")
 p()
 p("| target | goal | measured | |")
 p("|---|---:|---:|---|")
 for name, goal, got in targets:
-    if name.startswith("CLI"):
+    if name.startswith("CLI") or name.startswith("the same, process"):
         ok = got is not None and got <= goal
         p(f"| {name} | <= {goal:g} s | {fmt(got, 2)} s | {'met' if ok else 'NOT met'} |")
     else:
