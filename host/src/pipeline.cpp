@@ -108,8 +108,12 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
                        const StageCallback& on_stage) {
   validate(params);
   RunResult r;
-  r.backend = backend.name();
-  r.device = backend.device();
+  // Named once the stages are done: a backend still being set up (the CLI's) is waited for
+  // only when a stage first needs it.
+  auto name_backend = [&] {
+    r.backend = backend.name();
+    r.device = backend.device();
+  };
   StageTimer timer(r.timings_ms, on_stage);
 
   // Calibration files are read first: a typo there should not cost a full run.
@@ -130,6 +134,7 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
       transform_trajectory(r.trajectory, *T_base_camera);
       for (Trajectory& t : r.extra_trajectories) transform_trajectory(t, *T_base_camera);
     }
+    name_backend();
     return r;
   }
 
@@ -174,6 +179,7 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
                                   params.median_max_iterations, params.median_tolerance);
   if (T_base_camera) transform_trajectory(r.trajectory, *T_base_camera);
   timer.lap("trajectory");
+  name_backend();
   return r;
 }
 
