@@ -26,16 +26,7 @@ const Cloud& voxels(int width) {
   static std::map<int, Cloud> cache;
   auto it = cache.find(width);
   if (it == cache.end()) {
-    const CreaseMap map = crease_map(frame(width), RobustParams{});
-    Cloud c;
-    c.resize(map.points.size());
-    c.width = static_cast<std::uint32_t>(map.points.size());
-    for (std::size_t i = 0; i < map.points.size(); ++i) {
-      c.x[i] = map.points[i].x();
-      c.y[i] = map.points[i].y();
-      c.z[i] = map.points[i].z();
-    }
-    c.viewpoint = frame(width).viewpoint;
+    Cloud c = voxel_cloud(crease_map(frame(width), RobustParams{}));
     it = cache.emplace(width, std::move(c)).first;
   }
   return it->second;

@@ -42,20 +42,8 @@ std::unique_ptr<FeatureBackend> opencl_backend() {
   auto b = opencl_backend(); \
   if (!b) GTEST_SKIP() << "no OpenCL device on this machine"
 
-// The robust method's voxel cloud of a synth scan (640x480 unless given).
-Cloud voxels_of(const Cloud& scan) {
-  const CreaseMap map = crease_map(scan, RobustParams{});
-  Cloud c;
-  c.resize(map.points.size());
-  c.width = static_cast<std::uint32_t>(map.points.size());
-  for (std::size_t i = 0; i < map.points.size(); ++i) {
-    c.x[i] = map.points[i].x();
-    c.y[i] = map.points[i].y();
-    c.z[i] = map.points[i].z();
-  }
-  c.viewpoint = scan.viewpoint;
-  return c;
-}
+// The robust method's voxel cloud of a synth scan.
+Cloud voxels_of(const Cloud& scan) { return voxel_cloud(crease_map(scan, RobustParams{})); }
 
 SynthScan synth_scan(Shape shape, unsigned seed, double tilt_deg = 10) {
   SynthParams sp;

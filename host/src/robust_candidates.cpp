@@ -161,8 +161,8 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBack
   map.normals.resize(n);
 
   // The per-voxel work (a plane and a quantile over ~300 voxels each) is the backend's.
-  Cloud voxels = as_cloud(map.points);
-  voxels.viewpoint = cloud.viewpoint;
+  map.viewpoint = cloud.viewpoint;
+  const Cloud voxels = voxel_cloud(map);
   CreaseParams cp;
   cp.radius = static_cast<float>(params.scale);
   cp.own_radius = static_cast<float>(kOwnRadius * params.scale);
@@ -180,6 +180,12 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBack
   // into candidates; 1% of the scale is far below any groove the scale is meant for.
   map.threshold = median + std::max(params.threshold_k * sigma, 0.01 * params.scale);
   return map;
+}
+
+Cloud voxel_cloud(const CreaseMap& map) {
+  Cloud c = as_cloud(map.points);
+  c.viewpoint = map.viewpoint;
+  return c;
 }
 
 CreaseNodes crease_nodes(const CreaseMap& map, const RobustParams& params) {

@@ -39,18 +39,6 @@ struct Context {
   double half_window;
 };
 
-Cloud voxel_cloud(const CreaseMap& map) {
-  Cloud c;
-  c.resize(map.points.size());
-  c.width = static_cast<std::uint32_t>(map.points.size());
-  for (std::size_t v = 0; v < map.points.size(); ++v) {
-    c.x[v] = map.points[v].x();
-    c.y[v] = map.points[v].y();
-    c.z[v] = map.points[v].z();
-  }
-  return c;
-}
-
 // The surface normal at p: the plane of the voxels within `scale` of p that are not in a
 // groove (concavity below half the candidate threshold), PCA reweighted twice (Tukey on the
 // distance to the plane, scale from the residuals' MAD). Only the top surface counts, so a

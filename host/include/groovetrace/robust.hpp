@@ -43,6 +43,7 @@ struct CreaseMap {
   std::vector<Eigen::Vector3f> normals;  ///< plane normal at `scale`, towards the viewpoint
   std::vector<float> concavity;          ///< m: upper envelope minus own height (> 0: concave)
   std::vector<std::int32_t> voxel;       ///< per input point: its voxel, -1 if invalid
+  Eigen::Vector3f viewpoint{0, 0, 0};    ///< the cloud's viewpoint (m)
   double median = 0.0;                   ///< of concavity over voxels (m)
   double sigma = 0.0;                    ///< 1.4826 * MAD of concavity (m)
   double threshold = 0.0;                ///< candidate threshold (m)
@@ -55,6 +56,10 @@ struct CreaseMap {
 /// per-voxel measure runs on `backend` (FeatureBackend::crease); without one, on the cpu.
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend);
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
+
+/// The voxel centroids of `map` as an unorganized cloud (same frame, metres; the map's
+/// viewpoint): what FeatureBackend::crease measures.
+Cloud voxel_cloud(const CreaseMap& map);
 
 /// Crease nodes: candidate voxels that are the deepest across the seam (non-maximum
 /// suppression in a slab across the local seam direction).
