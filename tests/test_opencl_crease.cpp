@@ -25,22 +25,12 @@
 #include <numeric>
 #include <random>
 
+#include "opencl_support.hpp"
+
 namespace groovetrace {
 namespace {
 
 constexpr double kShare = 0.999;
-
-std::unique_ptr<FeatureBackend> opencl_backend() {
-  try {
-    return make_opencl_backend();
-  } catch (const OpenClError&) {
-    return nullptr;
-  }
-}
-
-#define REQUIRE_OPENCL(b)    \
-  auto b = opencl_backend(); \
-  if (!b) GTEST_SKIP() << "no OpenCL device on this machine"
 
 // The robust method's voxel cloud of a synth scan.
 Cloud voxels_of(const Cloud& scan) { return voxel_cloud(crease_map(scan, RobustParams{})); }
@@ -55,11 +45,6 @@ SynthScan synth_scan(Shape shape, unsigned seed, double tilt_deg = 10) {
   return render(sp);
 }
 
-double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-  const Eigen::Vector3d ad = a.cast<double>(), bd = b.cast<double>();
-  return std::atan2(ad.cross(bd).norm(), ad.dot(bd)) * 180.0 / M_PI;
-}
-
 // Both measures of one cloud agree within the tolerances above; returns the largest
 // concavity difference (m).
 double expect_crease_parity(FeatureBackend& cl, const Cloud& cloud, const CreaseParams& p,
@@ -72,7 +57,7 @@ double expect_crease_parity(FeatureBackend& cl, const Cloud& cloud, const Crease
   double worst = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const bool rv = ref.normals.valid(i), gv = got.normals.valid(i);
-    if (rv == gv && (!rv || angle_deg(ref.normals.normal(i), got.normals.normal(i)) <= 0.5)) {
+    if (rv == gv && (!rv || test::angle_deg(ref.normals.normal(i), got.normals.normal(i)) <= 0.5)) {
       ++normals_ok;
     }
     const bool rn = std::isnan(ref.concavity[i]), gn = std::isnan(got.concavity[i]);
@@ -123,33 +108,13 @@ TEST(OpenClCrease, RawOrganizedFrameAndShuffledCopy) {
   p.radius = 0.004f;
   p.own_radius = 0.0012f;
   expect_crease_parity(*cl, frame, p, "organized");
-  std::vector<std::size_t> order(frame.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::shuffle(order.begin(), order.end(), std::mt19937(5));
-  Cloud mixed;
-  mixed.resize(frame.size());
-  mixed.width = static_cast<std::uint32_t>(frame.size());
-  mixed.viewpoint = frame.viewpoint;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    mixed.x[k] = frame.x[order[k]];
-    mixed.y[k] = frame.y[order[k]];
-    mixed.z[k] = frame.z[order[k]];
-  }
-  expect_crease_parity(*cl, mixed, p, "shuffled");
+  expect_crease_parity(*cl, test::shuffled(frame, 5), p, "shuffled");
 }
 
 // One query per work-item (VW = 1), the kernels' form for GPUs.
 TEST(OpenClCrease, OneLanePerWorkItemAsOnGpus) {
-  if (!opencl_backend()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const char* old = std::getenv("GROOVETRACE_OPENCL_VW");
-  const std::string saved = old ? old : "";
-  setenv("GROOVETRACE_OPENCL_VW", "1", 1);
-  auto scalar = opencl_backend();
-  if (old) {
-    setenv("GROOVETRACE_OPENCL_VW", saved.c_str(), 1);
-  } else {
-    unsetenv("GROOVETRACE_OPENCL_VW");
-  }
+  if (!test::opencl_backend()) GTEST_SKIP() << "no OpenCL device on this machine";
+  auto scalar = test::one_lane_opencl_backend();
   ASSERT_TRUE(scalar);
   expect_crease_parity(*scalar, voxels_of(synth_scan(Shape::kLShape, 15).cloud),
                        robust_crease_params(), "VW=1");

@@ -17,6 +17,7 @@
 #include <numeric>
 #include <random>
 
+#include "opencl_support.hpp"
 #include "scenes.hpp"
 
 namespace groovetrace {
@@ -25,30 +26,13 @@ namespace {
 constexpr float kRadius = 0.003f;
 constexpr double kShare = 0.999;
 
-std::unique_ptr<FeatureBackend> opencl_backend() {
-  try {
-    return make_opencl_backend();
-  } catch (const OpenClError&) {
-    return nullptr;
-  }
-}
-
-#define REQUIRE_OPENCL(b)    \
-  auto b = opencl_backend(); \
-  if (!b) GTEST_SKIP() << "no OpenCL device on this machine"
-
-double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-  const Eigen::Vector3d ad = a.cast<double>(), bd = b.cast<double>();
-  return std::atan2(ad.cross(bd).norm(), ad.dot(bd)) * 180.0 / M_PI;
-}
-
 // Share of points whose normals agree (both NaN, or both set and within max_deg).
 double normals_agree(const Normals& ref, const Normals& got, double max_deg) {
   EXPECT_EQ(ref.size(), got.size());
   std::size_t good = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
     if (ref.valid(i) != got.valid(i)) continue;
-    if (!ref.valid(i) || angle_deg(ref.normal(i), got.normal(i)) <= max_deg) ++good;
+    if (!ref.valid(i) || test::angle_deg(ref.normal(i), got.normal(i)) <= max_deg) ++good;
   }
   return ref.size() ? static_cast<double>(good) / ref.size() : 1.0;
 }
@@ -100,24 +84,6 @@ Cloud noisy_frame() {
     }
   }
   return c;
-}
-
-// The same points as an unorganized cloud in random order.
-Cloud shuffled(const Cloud& in, unsigned seed) {
-  std::vector<std::size_t> order(in.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::shuffle(order.begin(), order.end(), std::mt19937(seed));
-  Cloud out;
-  out.resize(in.size());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    out.x[k] = in.x[order[k]];
-    out.y[k] = in.y[order[k]];
-    out.z[k] = in.z[order[k]];
-  }
-  out.width = static_cast<std::uint32_t>(in.size());
-  out.height = 1;
-  out.viewpoint = in.viewpoint;
-  return out;
 }
 
 Cloud random_patch(int n, double half_extent, double noise, unsigned seed) {
@@ -186,7 +152,7 @@ TEST(OpenClParity, OrganizedNoiselessFrameAtSteepTilt) {
 
 TEST(OpenClParity, UnorganizedShuffledNoisyScan) {
   REQUIRE_OPENCL(cl);
-  expect_feature_parity(*cl, shuffled(noisy_frame(), 11), kRadius, "unorganized noisy");
+  expect_feature_parity(*cl, test::shuffled(noisy_frame(), 11), kRadius, "unorganized noisy");
 }
 
 TEST(OpenClParity, SmoothingOrganizedAndUnorganized) {
@@ -196,7 +162,7 @@ TEST(OpenClParity, SmoothingOrganizedAndUnorganized) {
   for (int order : {1, 2}) {
     SmoothParams sp;
     sp.order = order;
-    for (const Cloud& c : {frame, shuffled(frame, 5)}) {
+    for (const Cloud& c : {frame, test::shuffled(frame, 5)}) {
       const Cloud ref = cpu->smooth(c, sp), got = cl->smooth(c, sp);
       EXPECT_GE(clouds_agree(ref, got, 1e-6), kShare)
           << "order " << order << (c.organized() ? " organized" : " unorganized");
@@ -214,12 +180,12 @@ TEST(OpenClParity, FusedFeaturesMatchSeparateCalls) {
   REQUIRE_OPENCL(cl);
   auto cpu = make_cpu_backend();
   const Cloud frame = noisy_frame();
-  for (const Cloud& c : {frame, shuffled(frame, 9)}) {
+  for (const Cloud& c : {frame, test::shuffled(frame, 9)}) {
     const FeatureSet f = cl->features(c, kRadius, 5);
     const Normals n = cl->normals(c, kRadius, 5);
     EXPECT_EQ(normals_agree(n, f.normals, 0.0), 1.0);
     const Eigen::Vector3f ub = benchmark_normal(cpu->normals(c, kRadius, 5));
-    EXPECT_LT(angle_deg(ub, f.benchmark_normal), 1e-4);
+    EXPECT_LT(test::angle_deg(ub, f.benchmark_normal), 1e-4);
     EXPECT_GE(descriptors_agree(cl->descriptor(c, n, kRadius, f.benchmark_normal), f.descriptor),
               1.0);
   }
@@ -229,7 +195,7 @@ TEST(OpenClParity, GrooveLabelsOrganizedAndUnorganized) {
   REQUIRE_OPENCL(cl);
   const Cloud frame = noisy_frame();
   expect_label_parity(*cl, frame, "organized");
-  expect_label_parity(*cl, shuffled(frame, 13), "unorganized");
+  expect_label_parity(*cl, test::shuffled(frame, 13), "unorganized");
 }
 
 // The paper pipeline end to end on each backend: the same waypoints within 0.1 mm.
@@ -260,16 +226,8 @@ TEST(OpenClParity, OrganizedFrameAfterSmoothing) {
 
 // One query per work-item (VW = 1), the kernels' form for GPUs, on the same device.
 TEST(OpenClParity, OneLanePerWorkItemAsOnGpus) {
-  if (!opencl_backend()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const char* old = std::getenv("GROOVETRACE_OPENCL_VW");
-  const std::string saved = old ? old : "";
-  setenv("GROOVETRACE_OPENCL_VW", "1", 1);
-  auto scalar = opencl_backend();
-  if (old) {
-    setenv("GROOVETRACE_OPENCL_VW", saved.c_str(), 1);
-  } else {
-    unsetenv("GROOVETRACE_OPENCL_VW");
-  }
+  if (!test::opencl_backend()) GTEST_SKIP() << "no OpenCL device on this machine";
+  auto scalar = test::one_lane_opencl_backend();
   ASSERT_TRUE(scalar);
   test::VGrooveScene s;
   s.width = 320;
@@ -278,7 +236,7 @@ TEST(OpenClParity, OneLanePerWorkItemAsOnGpus) {
   s.noise_sigma = 0.0003;
   const Cloud c = test::render_vgroove(s).cloud;
   expect_feature_parity(*scalar, c, kRadius, "VW=1 organized");
-  expect_feature_parity(*scalar, shuffled(c, 3), kRadius, "VW=1 unorganized");
+  expect_feature_parity(*scalar, test::shuffled(c, 3), kRadius, "VW=1 unorganized");
   auto cpu = make_cpu_backend();
   EXPECT_GE(clouds_agree(cpu->smooth(c, SmoothParams{}), scalar->smooth(c, SmoothParams{}), 1e-6),
             kShare);
