@@ -14,19 +14,24 @@
 
 namespace groovetrace::test {
 
-/// Distance (m) from (x, y) to the polyline `path` (world xy, m); closed joins last to first.
-inline double polyline_distance(const std::vector<Eigen::Vector2d>& path, bool closed, double x,
-                                double y) {
-  const Eigen::Vector2d p(x, y);
+/// Distance (m) from p to the polyline `path` (any dimension, m); closed joins last to first.
+template <int D>
+double polyline_distance(const std::vector<Eigen::Matrix<double, D, 1>>& path, bool closed,
+                         const Eigen::Matrix<double, D, 1>& p) {
   double best = INFINITY;
   const std::size_t n = path.size();
   for (std::size_t k = 0; k + 1 < n + (closed ? 1 : 0); ++k) {
-    const Eigen::Vector2d a = path[k], b = path[(k + 1) % n];
-    const Eigen::Vector2d ab = b - a;
-    const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+    const Eigen::Matrix<double, D, 1> a = path[k], ab = path[(k + 1) % n] - a;
+    const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
     best = std::min(best, (a + t * ab - p).norm());
   }
   return best;
+}
+
+/// Distance (m) from (x, y) to the polyline `path` (world xy, m); closed joins last to first.
+inline double polyline_distance(const std::vector<Eigen::Vector2d>& path, bool closed, double x,
+                                double y) {
+  return polyline_distance(path, closed, Eigen::Vector2d(x, y));
 }
 
 /// Depth (m, >= 0) of a V-groove of top width `width` and depth `depth` at distance d from

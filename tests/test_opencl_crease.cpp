@@ -26,6 +26,7 @@
 #include <random>
 
 #include "opencl_support.hpp"
+#include "robust_scenes.hpp"
 
 namespace groovetrace {
 namespace {
@@ -164,14 +165,9 @@ TEST(OpenClCrease, EdgeCases) {
 
 // Shortest distance (m) from p to the polyline through `path`'s waypoints.
 double path_distance(const Trajectory& path, const Eigen::Vector3d& p) {
-  double best = INFINITY;
-  const auto& w = path.waypoints;
-  for (std::size_t k = 0; k + 1 < w.size(); ++k) {
-    const Eigen::Vector3d a = w[k].position, ab = w[k + 1].position - a;
-    const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
-    best = std::min(best, (a + t * ab - p).norm());
-  }
-  return best;
+  std::vector<Eigen::Vector3d> points;
+  for (const Waypoint& w : path.waypoints) points.push_back(w.position);
+  return test::polyline_distance(points, false, p);
 }
 
 // The robust method end to end on each backend (the default run: --method robust).

@@ -185,13 +185,7 @@ TEST(RobustDetect, SeamEndsStayOnThePart) {
   const Seam& truth = scan.truth.seams.at(0);
   double worst = 0;
   for (const Waypoint& w : t->waypoints) {
-    double best = INFINITY;
-    for (std::size_t k = 0; k + 1 < truth.root.size(); ++k) {
-      const Eigen::Vector3d a = truth.root[k], ab = truth.root[k + 1] - a;
-      const double u = std::clamp((w.position - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-      best = std::min(best, (a + u * ab - w.position).norm());
-    }
-    worst = std::max(worst, best);
+    worst = std::max(worst, test::polyline_distance(truth.root, false, w.position));
   }
   EXPECT_LT(worst, 0.0015);
 }
