@@ -37,47 +37,33 @@ __kernel void crease_grid(__global const float* xs, __global const float* ys,
   const float r2 = radius * radius, own2 = own_radius * own_radius;
 
   // Walk 1: the plane and the own ball.
-  vfloat cnt = 0.0f, s1x = 0.0f, s1y = 0.0f, s1z = 0.0f;
-  vfloat sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+  Moments mo = moments_zero();
   vfloat own_cnt = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
   Cand it = cand_begin(&s, false, &Q);
   FOR_EACH_CANDIDATE(&s, false, it, k) {
-    vfloat dx = cand_load(false, xs, k) - Q.p.x;
-    vfloat dy = cand_load(false, ys, k) - Q.p.y;
-    vfloat dz = cand_load(false, zs, k) - Q.p.z;
+    const vfloat dx = cand_load(false, xs, k) - Q.p.x;
+    const vfloat dy = cand_load(false, ys, k) - Q.p.y;
+    const vfloat dz = cand_load(false, zs, k) - Q.p.z;
     const vfloat d2 = dx * dx + dy * dy + dz * dz;
     const vint m = cand_mask(&s, false, &it, k) & (d2 <= r2);
-    dx = MASKED(dx, m);
-    dy = MASKED(dy, m);
-    dz = MASKED(dz, m);
-    cnt += MASKED((vfloat)(1.0f), m);
-    s1x += dx;
-    s1y += dy;
-    s1z += dz;
-    sxx = fma(dx, dx, sxx);
-    sxy = fma(dx, dy, sxy);
-    sxz = fma(dx, dz, sxz);
-    syy = fma(dy, dy, syy);
-    syz = fma(dy, dz, syz);
-    szz = fma(dz, dz, szz);
+    moments_add(&mo, dx, dy, dz, m);
     const vint own = m & (d2 <= own2);
     own_cnt += MASKED((vfloat)(1.0f), own);
     ox += MASKED(dx, own);
     oy += MASKED(dy, own);
     oz += MASKED(dz, own);
   }
+  const vfloat cnt = mo.n;
   const vint ok = Q.ok & (cnt >= (float)max(min_neighbors, 3));
-  const vfloat inv = 1.0f / fmax(cnt, 1.0f);
-  const vfloat mx = s1x * inv, my = s1y * inv, mz = s1z * inv;
-  const Sym3 cov = {sxx * inv - mx * mx, sxy * inv - mx * my, sxz * inv - mx * mz,
-                    syy * inv - my * my, syz * inv - my * mz, szz * inv - mz * mz};
+  V3 mean;
+  const Sym3 cov = moments_covariance(&mo, &mean);
   V3 n = sym3_smallest_eigenvector(cov);
   const V3 to_view = v3_sub(v3((vfloat)(vpx), (vfloat)(vpy), (vfloat)(vpz)), Q.p);
   n = v3_select(n, v3_neg(n), v3_dot(n, to_view) < 0.0f);
   const vfloat own_height = v3_dot(n, v3(ox, oy, oz)) / fmax(own_cnt, 1.0f);
 
   // The bracket. var = n' C n, the spread of the heights about their mean.
-  const vfloat mu = v3_dot(n, v3(mx, my, mz));
+  const vfloat mu = v3_dot(n, mean);
   const vfloat sd = sqrt(fmax(v3_dot(n, sym3_mul(&cov, n)), 0.0f));
   const vfloat slack = 1e-6f * radius;
   vfloat lo = mu - 0.7f * sd - slack, hi = mu + 2.2f * sd + slack;

@@ -7,6 +7,45 @@ typedef struct {
   vfloat a00, a01, a02, a11, a12, a22;
 } Sym3;
 
+// Sums over a query's neighbours of their offsets d from it (m): count, sum d and sum d d',
+// for a plane fit. Offsets from the query keep the float sums exact enough where absolute
+// coordinates would cancel.
+typedef struct {
+  vfloat n, x, y, z, xx, xy, xz, yy, yz, zz;
+} Moments;
+
+inline Moments moments_zero(void) {
+  const Moments m = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  return m;
+}
+
+// Adds offset d in the lanes of `in`.
+inline void moments_add(Moments* m, vfloat dx, vfloat dy, vfloat dz, vint in) {
+  dx = MASKED(dx, in);
+  dy = MASKED(dy, in);
+  dz = MASKED(dz, in);
+  m->n += MASKED((vfloat)(1.0f), in);
+  m->x += dx;
+  m->y += dy;
+  m->z += dz;
+  m->xx = fma(dx, dx, m->xx);
+  m->xy = fma(dx, dy, m->xy);
+  m->xz = fma(dx, dz, m->xz);
+  m->yy = fma(dy, dy, m->yy);
+  m->yz = fma(dy, dz, m->yz);
+  m->zz = fma(dz, dz, m->zz);
+}
+
+// The covariance about the mean offset (population), and the mean itself.
+inline Sym3 moments_covariance(const Moments* m, V3* mean) {
+  const vfloat inv = 1.0f / fmax(m->n, 1.0f);
+  *mean = v3(m->x * inv, m->y * inv, m->z * inv);
+  const Sym3 c = {m->xx * inv - mean->x * mean->x, m->xy * inv - mean->x * mean->y,
+                  m->xz * inv - mean->x * mean->z, m->yy * inv - mean->y * mean->y,
+                  m->yz * inv - mean->y * mean->z, m->zz * inv - mean->z * mean->z};
+  return c;
+}
+
 inline V3 sym3_mul(const Sym3* a, V3 v) {
   return v3(a->a00 * v.x + a->a01 * v.y + a->a02 * v.z, a->a01 * v.x + a->a11 * v.y + a->a12 * v.z,
             a->a02 * v.x + a->a12 * v.y + a->a22 * v.z);

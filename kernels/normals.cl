@@ -9,33 +9,18 @@ inline void normals_impl(const Search* s, bool organized, __global const float* 
                          __global float* nz) {
   const Queries Q = queries_of(s, organized, xs, ys, zs, get_global_id(0));
   const float r2 = s->radius * s->radius;
-  vfloat cnt = 0.0f, s1x = 0.0f, s1y = 0.0f, s1z = 0.0f;
-  vfloat sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+  Moments mo = moments_zero();
   Cand it = cand_begin(s, organized, &Q);
   FOR_EACH_CANDIDATE(s, organized, it, k) {
-    vfloat dx = cand_load(organized, xs, k) - Q.p.x;
-    vfloat dy = cand_load(organized, ys, k) - Q.p.y;
-    vfloat dz = cand_load(organized, zs, k) - Q.p.z;
-    const vint m = cand_mask(s, organized, &it, k) & (dx * dx + dy * dy + dz * dz <= r2);
-    dx = MASKED(dx, m);
-    dy = MASKED(dy, m);
-    dz = MASKED(dz, m);
-    cnt += MASKED((vfloat)(1.0f), m);
-    s1x += dx;
-    s1y += dy;
-    s1z += dz;
-    sxx = fma(dx, dx, sxx);
-    sxy = fma(dx, dy, sxy);
-    sxz = fma(dx, dz, sxz);
-    syy = fma(dy, dy, syy);
-    syz = fma(dy, dz, syz);
-    szz = fma(dz, dz, szz);
+    const vfloat dx = cand_load(organized, xs, k) - Q.p.x;
+    const vfloat dy = cand_load(organized, ys, k) - Q.p.y;
+    const vfloat dz = cand_load(organized, zs, k) - Q.p.z;
+    moments_add(&mo, dx, dy, dz,
+                cand_mask(s, organized, &it, k) & (dx * dx + dy * dy + dz * dz <= r2));
   }
-  const vint ok = Q.ok & (cnt >= (float)max(min_neighbors, 3));
-  const vfloat inv = 1.0f / fmax(cnt, 1.0f);
-  const vfloat mx = s1x * inv, my = s1y * inv, mz = s1z * inv;
-  const Sym3 cov = {sxx * inv - mx * mx, sxy * inv - mx * my, sxz * inv - mx * mz,
-                    syy * inv - my * my, syz * inv - my * mz, szz * inv - mz * mz};
+  const vint ok = Q.ok & (mo.n >= (float)max(min_neighbors, 3));
+  V3 mean;
+  const Sym3 cov = moments_covariance(&mo, &mean);
   V3 n = sym3_smallest_eigenvector(cov);
   const V3 to_view = v3_sub(v3((vfloat)(vp.x), (vfloat)(vp.y), (vfloat)(vp.z)), Q.p);
   n = v3_select(n, v3_neg(n), v3_dot(n, to_view) < 0.0f);
