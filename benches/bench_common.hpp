@@ -7,14 +7,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/detect.hpp>
+#include <groovetrace/paper.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <map>
 #include <memory>
 
-#include "../tests/scenes.hpp"
+#include "support/scenes.hpp"
 
 namespace bench {
 

@@ -3,7 +3,8 @@
 # docs/benchmarks.md: points per second, the OpenCL backend's ratios to the CPU backend and
 # the PCL peers, the floating-point work per point against the machine's peak, and the
 # scaling of unorganized clouds.
-#   scripts/bench.sh [BUILD_DIR]      (default: build; needs BUILD_BENCHMARKS=ON)
+#   scripts/bench.sh [BUILD_DIR]      (default: build, configured with -DBUILD_BENCHMARKS=ON:
+#                                     scripts/build.sh -DBUILD_BENCHMARKS=ON)
 # Other compiles or runs on the machine disturb the timings: run it on a quiet machine (the
 # load average before and after goes into the report).
 set -euo pipefail

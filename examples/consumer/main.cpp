@@ -1,6 +1,6 @@
 // Uses groovetrace as a library: builds a small V-groove cloud in memory, runs the feature
 // backend and detection stages, and prints what was found. Exit 0 when a groove is found.
-#include <groovetrace/detect.hpp>
+#include <groovetrace/paper.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/pipeline.hpp>
 

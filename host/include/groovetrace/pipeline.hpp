@@ -2,7 +2,7 @@
 // The whole `run`: features, detection, trajectory, frames, and the output files.
 
 #include <groovetrace/cloud.hpp>
-#include <groovetrace/detect.hpp>
+#include <groovetrace/paper.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/params.hpp>
 #include <groovetrace/robust.hpp>

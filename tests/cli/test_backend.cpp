@@ -1,0 +1,115 @@
+// Backend choice from the CLI: `auto` (the default) takes the OpenCL device when there is one;
+// when no OpenCL platform exists it falls back to the CPU backend and says so, and an explicit
+// `opencl` is an error (exit 5), not a silent fallback.
+#include <gtest/gtest.h>
+
+#include <groovetrace/cloud_io.hpp>
+#include <groovetrace/opencl.hpp>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "support/cli_runner.hpp"
+#include "support/scenes.hpp"
+
+namespace groovetrace {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The ICD loader finds platforms through the vendor files in this directory; an empty one
+// means no OpenCL platform at all, as on a machine without a driver.
+const char* kNoOpenCl = "OCL_ICD_VENDORS=/nonexistent-groovetrace-icd";
+
+class CliBackend : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    test::VGrooveScene s;
+    s.width = 320;
+    s.height = 240;
+    scan_ = dir_ / "scan.pcd";
+    write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));
+  }
+  fs::path dir_, scan_;
+};
+
+TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend auto --method paper", dir_,
+      kNoOpenCl);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  ASSERT_FALSE(report["warnings"].empty());
+  EXPECT_NE(report["warnings"][0].get<std::string>().find("OpenCL unavailable"), std::string::npos);
+}
+
+TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
+      kNoOpenCl);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
+}
+
+// A kernel build failure on an explicit `--backend opencl`: exit 5, one line that names the
+// file holding the compiler's full output, and no outputs.
+TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const std::string env =
+      "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";  // common.cl refuses it
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
+      env);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  // One line of ours; PoCL's compiler prints its own count of errors to stderr as well.
+  std::istringstream lines(r.err);
+  int ours = 0;
+  for (std::string line; std::getline(lines, line);) ours += line.rfind("groovetrace:", 0) == 0;
+  EXPECT_EQ(ours, 1) << r.err;
+  EXPECT_NE(r.err.find("failed to build"), std::string::npos) << r.err;
+  const fs::path log = dir_ / "groovetrace-opencl-build.log";
+  EXPECT_NE(r.err.find(log.string()), std::string::npos) << r.err;
+  EXPECT_NE(test::read_text(log).find("VW must be"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
+}
+
+TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
+                                   " --method paper --backend opencl --device no-such-device-name",
+                               dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no-such-device-name"), std::string::npos) << r.err;
+}
+
+// The default run (--method robust, --backend auto) measures the creases with OpenCL on a
+// machine that has a device, and report.json names it; without a platform it falls back to the
+// cpu and says so.
+TEST_F(CliBackend, DefaultRunUsesOpenClAndNamesTheDevice) {
+  const std::vector<OpenClDevice> devices = list_opencl_devices();
+  if (devices.empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  auto r = test::run_cli("run " + scan_.string() + " -o " + out.string(), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["method"], "robust");
+  EXPECT_EQ(report["backend"], "opencl");
+  EXPECT_NE(report["device"].get<std::string>().find(devices[0].name), std::string::npos)
+      << report["device"];
+
+  r = test::run_cli("run " + scan_.string() + " -o " + out.string(), dir_, kNoOpenCl);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
+  report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+}
+
+}  // namespace
+}  // namespace groovetrace

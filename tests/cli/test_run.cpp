@@ -1,0 +1,147 @@
+// `groovetrace run` end to end on a rendered 640x480 V-groove with known geometry.
+#include <gtest/gtest.h>
+#include <groovetrace/cloud_io.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include "support/cli_runner.hpp"
+#include "support/scenes.hpp"
+
+namespace groovetrace {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CsvPose {
+  Eigen::Vector3d p;
+  Eigen::Quaterniond q;
+};
+
+std::vector<CsvPose> read_trajectory_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "idx,x_m,y_m,z_m,qx,qy,qz,qw,rx,ry,rz");
+  std::vector<CsvPose> poses;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    EXPECT_EQ(v.size(), 11u);
+    poses.push_back({Eigen::Vector3d(v[1], v[2], v[3]), Eigen::Quaterniond(v[7], v[4], v[5], v[6])});
+  }
+  return poses;
+}
+
+class CliRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    test::VGrooveScene s;  // 640x480 at 0.4 m, 10 mm wide, 4 mm deep groove
+    s.tilt_deg = 12;
+    s.yaw_deg = 8;
+    s.noise_sigma = 0.0002;
+    scene_ = test::render_vgroove(s);
+    scene_params_ = s;
+    scan_ = dir_ / "scan.pcd";
+    write_file_atomic(scan_.string(), pcd_bytes(scene_.cloud));
+  }
+  fs::path dir_, scan_;
+  test::RenderedScene scene_;
+  test::VGrooveScene scene_params_;
+};
+
+TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --method paper --backend cpu", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("outputs in"), std::string::npos) << r.out;
+  for (const char* f :
+       {"annotated.pcd", "trajectory.csv", "trajectory.json", "program.script", "report.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
+  }
+
+  // Waypoints follow the groove: the paper's geometric median sits between the walls, so
+  // compare with the groove's centre line at half depth (2 mm tolerance, the bound),
+  // and require the lateral offset alone to be small.
+  const Eigen::Vector3d dir = scene_.groove_dir_camera;
+  const Eigen::Vector3d mid = scene_.root_point_camera + scene_.up_camera * (scene_params_.depth / 2);
+  const auto poses = read_trajectory_csv(out / "trajectory.csv");
+  ASSERT_EQ(poses.size(), 50u);
+  double max_dist = 0, max_lateral = 0;
+  for (const auto& pose : poses) {
+    Eigen::Vector3d off = pose.p - mid;
+    off -= off.dot(dir) * dir;
+    max_dist = std::max(max_dist, off.norm());
+    const Eigen::Vector3d across = dir.cross(scene_.up_camera);
+    max_lateral = std::max(max_lateral, std::abs(off.dot(across)));
+    // The torch points into the plate: tool z against the plate normal, within 10 deg.
+    const Eigen::Vector3d z = pose.q.normalized().toRotationMatrix().col(2);
+    EXPECT_GT(z.dot(-scene_.up_camera), std::cos(10 * M_PI / 180));
+  }
+  EXPECT_LT(max_dist, 0.002);
+  EXPECT_LT(max_lateral, 0.001);
+  // Ordered along the groove, spanning most of the visible length.
+  const Eigen::Vector3d along = poses.back().p - poses.front().p;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    EXPECT_GT((poses[i].p - poses[i - 1].p).dot(along), 0.0) << "waypoint " << i;
+  }
+  EXPECT_GT((poses.back().p - poses.front().p).norm(), 0.15);
+
+  // annotated.pcd keeps the input shape and marks the groove where the truth is.
+  const Cloud annotated = read_cloud((out / "annotated.pcd").string());
+  EXPECT_EQ(annotated.width, 640u);
+  EXPECT_EQ(annotated.height, 480u);
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  EXPECT_EQ(report["points"]["total"], 640 * 480);
+  EXPECT_GT(report["points"]["groove"].get<int>(), 1000);
+  EXPECT_TRUE(report["timings_ms"].contains("descriptor"));
+  EXPECT_DOUBLE_EQ(report["parameters"]["radius"].get<double>(), 0.003);
+
+  const std::string script = test::read_text(out / "program.script");
+  EXPECT_NE(script.find("def weld_seam():"), std::string::npos);
+  std::size_t moves = 0;
+  for (auto at = script.find("movep("); at != std::string::npos; at = script.find("movep(", at + 1)) {
+    ++moves;
+  }
+  EXPECT_EQ(moves, poses.size() - 1);  // every waypoint after the first is a movep
+}
+
+TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
+  const fs::path out = dir_ / "out_cfg";
+  const fs::path cfg = dir_ / "cfg.yaml";
+  std::ofstream(cfg) << "slices: 20\nthreshold: 6.0\nweld_speed: 0.01\n";
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --config " +
+                                   cfg.string() + " --method paper --slices 30 --backend cpu -q",
+                               dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");  // --quiet
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["parameters"]["slices"], 30);                     // flag wins
+  EXPECT_DOUBLE_EQ(report["parameters"]["threshold"].get<double>(), 6.0);  // from config
+  EXPECT_DOUBLE_EQ(report["parameters"]["weld_speed"].get<double>(), 0.01);
+  EXPECT_EQ(read_trajectory_csv(out / "trajectory.csv").size(), 30u);
+}
+
+TEST_F(CliRun, AutoThresholdFindsTheGroove) {
+  const fs::path out = dir_ / "out_auto";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --method paper --threshold auto --backend cpu",
+      dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["detection"]["threshold_mode"], "otsu_log_descriptor");
+  EXPECT_EQ(report["parameters"]["threshold"], "auto");
+  const auto poses = read_trajectory_csv(out / "trajectory.csv");
+  const Eigen::Vector3d dir = scene_.groove_dir_camera;
+  const Eigen::Vector3d across = dir.cross(scene_.up_camera);
+  for (const auto& pose : poses) {
+    EXPECT_LT(std::abs((pose.p - scene_.root_point_camera).dot(across)), 0.001);
+  }
+}
+
+}  // namespace
+}  // namespace groovetrace
