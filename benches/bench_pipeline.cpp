@@ -41,7 +41,7 @@ void run_groovetrace(const std::string& backend_name, int width) {
   const Cloud cloud = read_cloud(path);
   auto backend = make_backend(backend_name);
   Params params;
-  params.method = "paper";  // the method whose features the backends compute
+  params.method = Method::paper;  // the method whose features the backends compute
   params.backend = backend_name;
   const RunResult result = run_pipeline(cloud, params, *backend);
   write_outputs((bench_dir() / ("out-" + backend_name)).string(),
@@ -69,32 +69,35 @@ void BM_RunPcl(benchmark::State& state) {
     const auto normals = pcl_normals(smoothed, kRadius, false, Eigen::Vector3f::Zero());
     const Eigen::Vector3f u_b = pcl_benchmark_normal(normals);
     RunResult r;
-    r.descriptor = pcl_gfh(smoothed, normals, kRadius, u_b);
-    r.benchmark_normal = u_b;
+    r.method = Method::paper;
+    r.score = pcl_gfh(smoothed, normals, kRadius, u_b);
+    r.score_unit = "deg^2";
     // Detection, trajectory and outputs are groovetrace's: PCL has no counterpart.
-    r.smoothed.resize(smoothed->size());
+    Cloud& cloud = r.paper.smoothed;
+    cloud.resize(smoothed->size());
     r.normals.resize(smoothed->size());
     for (std::size_t i = 0; i < smoothed->size(); ++i) {
-      r.smoothed.x[i] = (*smoothed)[i].x;
-      r.smoothed.y[i] = (*smoothed)[i].y;
-      r.smoothed.z[i] = (*smoothed)[i].z;
+      cloud.x[i] = (*smoothed)[i].x;
+      cloud.y[i] = (*smoothed)[i].y;
+      cloud.z[i] = (*smoothed)[i].z;
       r.normals.x[i] = normals[i].normal_x;
       r.normals.y[i] = normals[i].normal_y;
       r.normals.z[i] = normals[i].normal_z;
     }
-    r.smoothed.width = static_cast<std::uint32_t>(smoothed->size());
+    cloud.width = static_cast<std::uint32_t>(smoothed->size());
     Params params;
-    params.method = "paper";
-    r.detection =
-        detect_groove(r.smoothed, r.descriptor, params.threshold, params.min_component, kRadius);
-    std::vector<std::uint8_t> largest(r.smoothed.size());
-    for (std::size_t i = 0; i < largest.size(); ++i) {
-      largest[i] = r.detection.component_label[i] == 0 ? 1 : 0;
+    params.method = Method::paper;
+    const PaperParams& pp = params.paper;
+    r.paper.detection = detect_groove(cloud, r.score, pp.threshold, pp.min_component, kRadius);
+    r.groove = r.paper.detection.groove;
+    std::vector<std::uint8_t> largest(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      largest[i] = r.paper.detection.component_label[i] == 0 ? 1 : 0;
     }
-    r.trajectory = paper_trajectory(r.smoothed, r.normals, largest, params.slices);
+    r.trajectories.push_back(paper_trajectory(cloud, r.normals, largest, pp.slices));
     r.backend = "pcl";
     write_outputs((bench_dir() / "out-pcl").string(),
-                  render_outputs(r.smoothed, r, params, path, 0.0));
+                  render_outputs(cloud, r, params, path, 0.0));
   }
   report_points(state, frame(state.range(0)).size());
 }

@@ -425,7 +425,7 @@ def write_results(args, records, methods):
              "0.30-0.55 m, tilt -20..20 deg across the seam, a seed per scan. One default "
              "configuration (`groovetrace run --method M`, only `--max-seams 2` for `multi`, "
              "whose two seams are both the truth). Metrics from `groovetrace eval` "
-             "(DESIGN.md, \"Metrics\"); coverage of `multi` with two seams is over the union of "
+             "(docs/design.md, \"Metrics\"); coverage of `multi` with two seams is over the union of "
              "both trajectories. Method: docs/method-robust.md.")
     L.append("")
     L.append("Targets (issue 4): IoU >= 90 % at 1280x720 and >= 84 % at 640x480; lateral mean "

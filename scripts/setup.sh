@@ -5,7 +5,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config
       libpcl-dev libeigen3-dev libomp-dev
       pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
-      libgtest-dev libgmock-dev libbenchmark-dev
+      libgtest-dev libgmock-dev libbenchmark-dev clang-format
       libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
       python3-numpy python3-matplotlib)
 missing=()

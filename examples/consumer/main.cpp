@@ -24,12 +24,19 @@ int main() {
       cloud.z[i] = 0.4f + groove;
     }
   }
-  Params params;
-  params.slices = 10;
   auto backend = make_backend("cpu");
-  const RunResult result = run_pipeline(cloud, params, *backend);
-  std::printf("groovetrace %s: %zu groove points, %zu waypoints\n", version(),
-              result.detection.component_sizes.empty() ? 0 : result.detection.component_sizes[0],
-              result.trajectory.waypoints.size());
-  return result.trajectory.waypoints.size() >= 2 ? 0 : 1;
+  bool found = true;
+  for (const Method method : {Method::robust, Method::paper}) {
+    Params params;
+    params.method = method;
+    params.paper.slices = 10;
+    const RunResult result = run_pipeline(cloud, params, *backend);
+    const Trajectory& path = result.trajectories.front();
+    std::printf("groovetrace %s, %s method: %zu groove points, %zu waypoints, %.1f mm long\n",
+                version(), to_string(method),
+                static_cast<std::size_t>(std::count(result.groove.begin(), result.groove.end(), 1)),
+                path.waypoints.size(), path.length * 1000);
+    found = found && path.waypoints.size() >= 2;
+  }
+  return found ? 0 : 1;
 }

@@ -9,6 +9,7 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
+#include <algorithm>
 #include <map>
 #include <memory>
 
@@ -50,18 +51,33 @@ void check_output_dir(const std::string& dir) {
   }
 }
 
-int run(const RunOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
+// The config file, then the flags; warnings for the keys that the chosen method ignores.
+Params parse_params(const RunOptions& opt, std::vector<std::string>& warnings) {
   Params params;
-  if (!opt.config.empty()) apply_config_file(params, opt.config);
+  std::vector<std::string> keys;
+  if (!opt.config.empty()) keys = apply_config_file(params, opt.config);
   for (const auto& [key, text] : opt.flags) {
     try {
       set_param(params, key, text);
     } catch (const UsageError& e) {
       throw UsageError("--" + dashed(key) + ": " + std::string(e.what()).substr(key.size() + 2));
     }
+    keys.push_back(key);
   }
   validate(params);
+  for (const std::string& key : keys) {
+    const std::string w = other_method_warning(params, key);
+    if (!w.empty() && std::find(warnings.begin(), warnings.end(), w) == warnings.end()) {
+      warnings.push_back(w);
+    }
+  }
+  return params;
+}
+
+int run(const RunOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::string> param_warnings;
+  const Params params = parse_params(opt, param_warnings);
   check_output_dir(opt.out_dir);
   auto say = [&](const char* fmt, auto... args) {
     if (!opt.quiet) {
@@ -91,6 +107,7 @@ int run(const RunOptions& opt) {
   });
   result.timings_ms.insert(result.timings_ms.begin(), {"load", load_ms});
   // A backend that fell back (auto without a usable OpenCL device) says why, in report.json too.
+  result.warnings.insert(result.warnings.begin(), param_warnings.begin(), param_warnings.end());
   if (!backend.warning().empty())
     result.warnings.insert(result.warnings.begin(), backend.warning());
   for (const auto& w : result.warnings)
@@ -103,11 +120,10 @@ int run(const RunOptions& opt) {
   const double write_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_write).count();
   say("groovetrace: write      %8.0f ms\n", write_ms);
+  const Trajectory& best = result.trajectories.front();
   say("groovetrace: %zu groove points, %zu waypoints (%s frame), %.1f mm long\n",
-      static_cast<std::size_t>(
-          std::count(result.detection.groove.begin(), result.detection.groove.end(), 1)),
-      result.trajectory.waypoints.size(), result.trajectory.frame.c_str(),
-      result.trajectory.length * 1000);
+      static_cast<std::size_t>(std::count(result.groove.begin(), result.groove.end(), 1)),
+      best.waypoints.size(), best.frame.c_str(), best.length * 1000);
   say("groovetrace: outputs in %s:", opt.out_dir.c_str());
   for (const auto& f : files) say(" %s", f.first.c_str());
   say("\n");

@@ -1,10 +1,10 @@
 // groovetrace CLI: subcommands run, synth, eval. Every failure ends as one line on stderr
-// and the exit code of DESIGN.md.
+// and the exit code of docs/design.md ("CLI contract").
 #include <filesystem>
 #include <fstream>
 #include <groovetrace/error.hpp>
 #include <groovetrace/opencl.hpp>
-#include <groovetrace/pipeline.hpp>
+#include <groovetrace/version.hpp>
 #include <iostream>
 
 #include "commands.hpp"

@@ -175,7 +175,7 @@ TEST(OpenClCrease, RobustRunsAgree) {
   REQUIRE_OPENCL(cl);
   auto cpu = make_cpu_backend();
   Params params;
-  params.method = "robust";
+  params.method = Method::robust;
   const std::pair<Shape, unsigned> cases[] = {{Shape::kStraight, 21}, {Shape::kCylinder, 22}};
   for (const auto& [shape, seed] : cases) {
     const Cloud scan = synth_scan(shape, seed).cloud;
@@ -183,17 +183,17 @@ TEST(OpenClCrease, RobustRunsAgree) {
     const RunResult got = run_pipeline(scan, params, *cl);
     EXPECT_EQ(got.backend, "opencl");
     EXPECT_EQ(got.device, cl->device());
-    const auto& rw = ref.trajectory.waypoints;
+    const auto& rw = ref.trajectories.front().waypoints;
     ASSERT_GE(rw.size(), 10u) << shape_name(shape);
     EXPECT_LE(
-        std::abs(static_cast<long>(rw.size()) - static_cast<long>(got.trajectory.waypoints.size())),
+        std::abs(static_cast<long>(rw.size()) - static_cast<long>(got.trajectories.front().waypoints.size())),
         1)
         << shape_name(shape);
     // Both ways: each path's waypoints against the other path.
     for (const auto& [from, to] : {std::pair(&ref, &got), std::pair(&got, &ref)}) {
       std::vector<double> d;
-      for (const Waypoint& w : from->trajectory.waypoints) {
-        d.push_back(path_distance(to->trajectory, w.position));
+      for (const Waypoint& w : from->trajectories.front().waypoints) {
+        d.push_back(path_distance(to->trajectories.front(), w.position));
       }
       std::sort(d.begin(), d.end());
       // The backends' concavities differ by ~1 um; the seam's fits are chaotic in where
@@ -204,7 +204,7 @@ TEST(OpenClCrease, RobustRunsAgree) {
     }
     std::size_t same = 0;
     for (std::size_t i = 0; i < scan.size(); ++i) {
-      same += ref.detection.groove[i] == got.detection.groove[i] ? 1 : 0;
+      same += ref.groove[i] == got.groove[i] ? 1 : 0;
     }
     EXPECT_GE(static_cast<double>(same) / scan.size(), kShare) << shape_name(shape);
   }

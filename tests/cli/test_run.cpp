@@ -143,5 +143,35 @@ TEST_F(CliRun, AutoThresholdFindsTheGroove) {
   }
 }
 
+// A flag of the other method does nothing there: the user is told, on stderr and in
+// report.json, once per flag, whether it came from the config file or the command line.
+TEST_F(CliRun, FlagsOfTheOtherMethodAreWarnedAbout) {
+  const fs::path out = dir_ / "out_other";
+  const fs::path cfg = dir_ / "cfg.yaml";
+  std::ofstream(cfg) << "radius: 0.004\n";
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --config " +
+                                   cfg.string() + " --radius 0.005 --step 0.003 --slices 20" +
+                                   " --method paper --backend cpu -q",
+                               dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string step_warning = "step belongs to the robust method; the paper method ignores it";
+  EXPECT_NE(r.err.find("warning: " + step_warning), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("radius belongs"), std::string::npos) << r.err;  // paper's own
+  EXPECT_EQ(r.err.find("slices belongs"), std::string::npos) << r.err;  // both methods'
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["warnings"], nlohmann::json::array({step_warning}));
+
+  const fs::path out2 = dir_ / "out_other_robust";
+  const auto r2 = test::run_cli("run " + scan_.string() + " -o " + out2.string() + " --config " +
+                                    cfg.string() + " --radius 0.005 --backend cpu -q",
+                                dir_);
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  const std::string radius_warning =
+      "radius belongs to the paper method; the robust method ignores it";
+  const auto report2 = nlohmann::json::parse(test::read_text(out2 / "report.json"));
+  EXPECT_EQ(report2["warnings"], nlohmann::json::array({radius_warning}));  // once, not twice
+  EXPECT_EQ(report2["method"], "robust");
+}
+
 }  // namespace
 }  // namespace groovetrace

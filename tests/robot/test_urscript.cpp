@@ -16,7 +16,7 @@
 
 namespace {
 
-using groovetrace::Params;
+using groovetrace::ProgramParams;
 using groovetrace::Trajectory;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -49,8 +49,8 @@ Trajectory golden_trajectory() {
   return t;
 }
 
-Params golden_params() {
-  Params p;
+ProgramParams golden_params() {
+  ProgramParams p;
   p.approach_offset = 0.05;
   p.approach_speed = 0.25;
   p.weld_speed = 0.006;
@@ -143,7 +143,7 @@ Trajectory wavy_trajectory() {
 
 TEST(Urscript, ProgramStructure) {
   const Trajectory t = wavy_trajectory();
-  Params params;
+  ProgramParams params;
   params.blend_radius = 0.003;
   params.arc_output = 5;
   const std::string program = groovetrace::urscript_program(t, params);
@@ -259,7 +259,7 @@ TEST(Urscript, CameraFrameIsFlaggedAndBadInputsThrow) {
   EXPECT_NE(program.find("# frame: camera\n"), std::string::npos);
   EXPECT_NE(program.find("# WARNING"), std::string::npos);
 
-  Params bad = golden_params();
+  ProgramParams bad = golden_params();
   bad.weld_speed = 0.0;
   EXPECT_THROW(groovetrace::urscript_program(t, bad), groovetrace::UsageError);
   bad = golden_params();

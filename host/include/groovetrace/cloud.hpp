@@ -1,6 +1,7 @@
 #pragma once
 // A point cloud as plain structure-of-arrays data, the unit every stage consumes.
 
+#include <groovetrace/export.hpp>
 #include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
@@ -12,7 +13,7 @@ namespace groovetrace {
 /// Points in one frame (camera frame for sensor scans, or a robot base frame), in metres.
 /// Invalid returns are NaN and stay in place, so index i always means the same input point.
 /// Organized frames keep the sensor's row-major layout: index = row * width + col.
-struct Cloud {
+struct GT_API Cloud {
   std::vector<float> x, y, z;  ///< metres, in the cloud's frame
   std::uint32_t width = 0;     ///< points per row (== size() when unorganized)
   std::uint32_t height = 1;    ///< rows; 1 means unorganized
@@ -39,7 +40,7 @@ struct Cloud {
 
 /// Unit surface normals per point, in the cloud's frame; NaN where a point has too few
 /// neighbours (such points are never groove).
-struct Normals {
+struct GT_API Normals {
   std::vector<float> x, y, z;
   std::size_t size() const { return x.size(); }
   bool valid(std::size_t i) const { return std::isfinite(x[i]); }

@@ -11,9 +11,13 @@
 
 namespace groovetrace {
 
-struct ParamSpec {
+/// Which method a parameter belongs to.
+enum class ParamScope { common, paper, robust };
+
+struct GT_API ParamSpec {
   std::string key;   ///< snake_case name in config files and report.json
   std::string help;  ///< one line for --help, with unit
+  ParamScope scope = ParamScope::common;
   /// Parses a textual value into params; throws UsageError("<key>: ...") when invalid.
   std::function<void(Params&, const std::string&)> set;
   /// The current value as a JSON literal (number, string, bool, array or null).
@@ -21,18 +25,22 @@ struct ParamSpec {
 };
 
 /// Every parameter, in documentation order.
-const std::vector<ParamSpec>& param_specs();
+GT_API const std::vector<ParamSpec>& param_specs();
 
 /// Sets one parameter by key (dashes accepted for underscores). Throws UsageError for an
 /// unknown key or an invalid value.
-void set_param(Params& params, const std::string& key, const std::string& value);
+GT_API void set_param(Params& params, const std::string& key, const std::string& value);
 
 /// Applies a YAML (.yaml/.yml) or JSON (.json) config file: a flat map of key: value.
 /// Throws InputError if the file cannot be read or parsed, UsageError for unknown keys or
-/// invalid values (the message names the file and key).
-void apply_config_file(Params& params, const std::string& path);
+/// invalid values (the message names the file and key). Returns the keys it set.
+GT_API std::vector<std::string> apply_config_file(Params& params, const std::string& path);
+
+/// A warning when `key` belongs to the method that `params` does not run (e.g. `radius`
+/// under the robust method), naming both; empty when the key is common or the method's own.
+GT_API std::string other_method_warning(const Params& params, const std::string& key);
 
 /// All parameters as one JSON object (text).
-std::string params_json(const Params& params);
+GT_API std::string params_json(const Params& params);
 
 }  // namespace groovetrace

@@ -1,16 +1,17 @@
 #pragma once
 // Typed errors: each carries the process exit code the CLI contract assigns to it.
 
+#include <groovetrace/export.hpp>
 #include <stdexcept>
 #include <string>
 
 namespace groovetrace {
 
-/// Exit codes of the CLI (DESIGN.md): 0 ok, 2 bad usage, 3 bad input, 4 no groove, 5 internal.
+/// Exit codes of the CLI (docs/design.md, "CLI contract"): 0 ok, 2 bad usage, 3 bad input, 4 no groove, 5 internal.
 enum class ExitCode : int { kOk = 0, kUsage = 2, kInput = 3, kNoGroove = 4, kInternal = 5 };
 
 /// Base of every error groovetrace throws on purpose; what() is one line, fit for stderr.
-class Error : public std::runtime_error {
+class GT_API Error : public std::runtime_error {
  public:
   Error(ExitCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
   ExitCode code() const { return code_; }
@@ -20,19 +21,19 @@ class Error : public std::runtime_error {
 };
 
 /// A flag, config value or argument is wrong (exit 2).
-struct UsageError : Error {
+struct GT_API UsageError : Error {
   explicit UsageError(const std::string& m) : Error(ExitCode::kUsage, m) {}
 };
 /// A file cannot be read or holds no usable cloud; an output cannot be written (exit 3).
-struct InputError : Error {
+struct GT_API InputError : Error {
   explicit InputError(const std::string& m) : Error(ExitCode::kInput, m) {}
 };
 /// The scan was read but no groove was found in it (exit 4).
-struct NoGrooveError : Error {
+struct GT_API NoGrooveError : Error {
   explicit NoGrooveError(const std::string& m) : Error(ExitCode::kNoGroove, m) {}
 };
 /// A device or internal failure (exit 5).
-struct InternalError : Error {
+struct GT_API InternalError : Error {
   explicit InternalError(const std::string& m) : Error(ExitCode::kInternal, m) {}
 };
 

@@ -2,6 +2,7 @@
 // The per-point work (smoothing, normals, groove descriptor) behind one interface, so the
 // OpenCL kernels and the CPU reference are interchangeable and checked against each other.
 
+#include <groovetrace/export.hpp>
 #include <groovetrace/cloud.hpp>
 #include <memory>
 #include <string>
@@ -39,7 +40,7 @@ struct CreaseMeasure {
 
 /// Per-point work of the pipeline. Every method keeps input order and size; invalid (NaN)
 /// points stay invalid. Neighbours are the valid points within `radius` (m) in 3-D.
-class FeatureBackend {
+class GT_API FeatureBackend {
  public:
   virtual ~FeatureBackend() = default;
   /// "cpu" or "opencl".
@@ -83,17 +84,17 @@ class FeatureBackend {
 
 /// The benchmark normal u_b = normalize(sum of all valid normals) (paper eq. 4).
 /// Returns NaN if the normals sum to zero.
-Eigen::Vector3f benchmark_normal(const Normals& normals);
+GT_API Eigen::Vector3f benchmark_normal(const Normals& normals);
 
 /// Creates a backend by name: "cpu", "opencl" or "auto" (opencl when a device is present and
 /// the kernels build on it, else cpu with a warning() saying why). `device` picks the OpenCL
 /// device: an index into list_opencl_devices() or a name substring (see opencl.hpp); empty =
 /// the first GPU, else the first device. Throws UsageError for an unknown name or a device
 /// that matches nothing, OpenClError (an InternalError) when "opencl" cannot run.
-std::unique_ptr<FeatureBackend> make_backend(const std::string& name,
+GT_API std::unique_ptr<FeatureBackend> make_backend(const std::string& name,
                                              const std::string& device = "");
 
 /// The CPU reference backend (OpenMP + Eigen).
-std::unique_ptr<FeatureBackend> make_cpu_backend();
+GT_API std::unique_ptr<FeatureBackend> make_cpu_backend();
 
 }  // namespace groovetrace

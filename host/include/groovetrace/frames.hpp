@@ -1,6 +1,7 @@
 #pragma once
 // Rigid transforms from calibration files, and moving a trajectory into the robot base.
 
+#include <groovetrace/export.hpp>
 #include <groovetrace/trajectory.hpp>
 
 #include <Eigen/Geometry>
@@ -14,10 +15,10 @@ namespace groovetrace {
 ///   rotation: [qx, qy, qz, qw]      # unit quaternion (norm within 1e-3 of 1)
 /// Throws InputError for an unreadable file, missing or non-numeric fields, or a
 /// non-unit quaternion.
-Eigen::Isometry3d read_transform(const std::string& path);
+GT_API Eigen::Isometry3d read_transform(const std::string& path);
 
 /// Re-expresses a trajectory given in the camera frame in the base frame:
 /// T_base_camera = T_base_flange * T_flange_camera. Sets frame = "base".
-void transform_trajectory(Trajectory& trajectory, const Eigen::Isometry3d& T_base_camera);
+GT_API void transform_trajectory(Trajectory& trajectory, const Eigen::Isometry3d& T_base_camera);
 
 }  // namespace groovetrace

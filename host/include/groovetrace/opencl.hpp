@@ -7,6 +7,7 @@
 // GROOVETRACE_OPENCL_VW=1|2|4|8|16 sets the queries per work-item (default 16 on CPU devices,
 // 1 on GPUs); GROOVETRACE_OPENCL_OPTIONS adds OpenCL compiler options.
 
+#include <groovetrace/export.hpp>
 #include <cstdint>
 #include <groovetrace/error.hpp>
 #include <groovetrace/features.hpp>
@@ -29,11 +30,11 @@ struct OpenClDevice {
 
 /// Every device of every platform, platforms in driver order. Empty when no OpenCL driver is
 /// installed or the build has no OpenCL; never throws.
-std::vector<OpenClDevice> list_opencl_devices();
+GT_API std::vector<OpenClDevice> list_opencl_devices();
 
 /// An OpenCL call or program build failed (exit code 5). what() is one line; for a failed
 /// program build, build_log() holds the compiler's full output.
-class OpenClError : public InternalError {
+class GT_API OpenClError : public InternalError {
  public:
   OpenClError(const std::string& message, int status, std::string build_log = {})
       : InternalError(message), status_(status), build_log_(std::move(build_log)) {}
@@ -48,7 +49,7 @@ class OpenClError : public InternalError {
 
 /// Programs built by this process so far: each device's kernels are built once, on its first
 /// backend, and shared by every later one (a diagnostic for the cache).
-std::size_t opencl_program_builds();
+GT_API std::size_t opencl_program_builds();
 
 /// Bytes of OpenCL buffers held by this process's backends: now, and at most at once since the
 /// last reset (a diagnostic for memory per point; host arrays not included). On a CPU device
@@ -58,7 +59,7 @@ struct OpenClMemory {
   std::uint64_t current = 0, peak = 0;
 };
 /// The counters; with reset_peak, the peak restarts from the current bytes after reading.
-OpenClMemory opencl_memory(bool reset_peak = false);
+GT_API OpenClMemory opencl_memory(bool reset_peak = false);
 
 /// Creates the OpenCL backend on one device. `selector`: empty = the first GPU, else the
 /// first device; a number N = list_opencl_devices()[N]; anything else = the first device
@@ -66,6 +67,6 @@ OpenClMemory opencl_memory(bool reset_peak = false);
 /// OpenCL device or the kernels do not build on it (build_log() says why), UsageError when
 /// devices exist but none matches the selector. The backend is not thread-safe; create one
 /// per thread (they share the built program).
-std::unique_ptr<FeatureBackend> make_opencl_backend(const std::string& selector = "");
+GT_API std::unique_ptr<FeatureBackend> make_opencl_backend(const std::string& selector = "");
 
 }  // namespace groovetrace

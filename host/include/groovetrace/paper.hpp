@@ -5,6 +5,7 @@
 //
 // Frames and units: every 3-D quantity is in the cloud's frame, metres; D in deg^2.
 
+#include <groovetrace/export.hpp>
 #include <groovetrace/cloud.hpp>
 #include <groovetrace/trajectory.hpp>
 
@@ -16,7 +17,7 @@ namespace groovetrace {
 
 /// Otsu's threshold on log(D) over the finite, positive descriptor values (deg^2).
 /// log because D spans orders of magnitude between flats and creases. NaN if < 2 values.
-double otsu_threshold(const std::vector<float>& descriptor);
+GT_API double otsu_threshold(const std::vector<float>& descriptor);
 
 /// Connected parts of the points with mask[i] != 0: two points are linked when they are
 /// within `link_distance` (m) in 3-D. Returns a label per point (-1 outside the mask),
@@ -25,7 +26,7 @@ struct Components {
   std::vector<int> label;
   std::vector<std::size_t> sizes;
 };
-Components connected_components(const Cloud& cloud, const std::vector<std::uint8_t>& mask,
+GT_API Components connected_components(const Cloud& cloud, const std::vector<std::uint8_t>& mask,
                                  float link_distance);
 
 /// Result of detection: groove mask (1 = groove) and what was decided on the way.
@@ -40,14 +41,14 @@ struct Detection {
 
 /// Thresholds `descriptor` and keeps the connected parts with at least `min_component`
 /// points. `threshold` is used unless it is NaN, in which case Otsu's threshold is used.
-Detection detect_groove(const Cloud& cloud, const std::vector<float>& descriptor,
+GT_API Detection detect_groove(const Cloud& cloud, const std::vector<float>& descriptor,
                         double threshold, int min_component, float link_distance);
 
 /// Geometric median (minimum sum of distances) of `points` by Weiszfeld's iteration, which
 /// is gradient descent with the step that makes it monotone. Stops when a step moves less
 /// than `tolerance` (same unit as the points) or after `max_iterations`.
 /// Throws std::invalid_argument for an empty set.
-Eigen::Vector3d geometric_median(const std::vector<Eigen::Vector3d>& points,
+GT_API Eigen::Vector3d geometric_median(const std::vector<Eigen::Vector3d>& points,
                                  int max_iterations = 1000, double tolerance = 1e-7);
 
 /// Builds the paper's trajectory from the groove points (mask != 0 and a valid normal).
@@ -55,7 +56,7 @@ Eigen::Vector3d geometric_median(const std::vector<Eigen::Vector3d>& points,
 /// along +x of the cloud's frame (+y if the axis is perpendicular to x); `slices` equal
 /// slices along it each give one waypoint (empty slices give none).
 /// Throws NoGrooveError if fewer than 2 waypoints result, UsageError for slices < 1.
-Trajectory paper_trajectory(const Cloud& cloud, const Normals& normals,
+GT_API Trajectory paper_trajectory(const Cloud& cloud, const Normals& normals,
                             const std::vector<std::uint8_t>& mask, int slices,
                             int median_max_iterations = 1000, double median_tolerance = 1e-7);
 

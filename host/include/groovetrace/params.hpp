@@ -1,43 +1,61 @@
 #pragma once
-// Every tunable of a `run`, with its default. Config files and flags both write into this.
+// Every tunable of a `run`, with its default: the common ones, then each method's own. Config
+// files and flags both write into this through one table (config.hpp).
+//
+// Units: lengths in metres, speeds in m/s, angles in degrees, times in seconds.
 
 #include <Eigen/Core>
+#include <groovetrace/export.hpp>
 #include <optional>
 #include <string>
 
 namespace groovetrace {
 
-/// Parameters of the pipeline. Lengths in metres, speeds in m/s, angles in degrees.
-struct Params {
-  // Method and backend.
-  std::string method = "robust";  ///< "robust" (docs/method-robust.md) or "paper" (as published)
-  std::string backend = "auto";  ///< "auto", "cpu" or "opencl"
-  std::string device;            ///< OpenCL device: index or name part; empty = first GPU, else first
-  double units_scale = 1.0;      ///< input coordinates * units_scale = metres (mm: 0.001)
+/// The detection method of a run.
+enum class Method {
+  robust,  ///< the default: docs/method-robust.md
+  paper,   ///< as published (Peng et al.): README, "Paper method notes"
+};
 
-  // Features.
-  bool smooth = true;            ///< run MLS smoothing before normals
-  double mls_radius = 0.003;     ///< MLS search radius (m)
-  int mls_order = 2;             ///< MLS polynomial order: 1 = plane projection, 2 = quadric
-  double radius = 0.003;         ///< neighbourhood radius r for normals and the GFH (m)
-  int min_neighbors = 5;         ///< fewer neighbours within r: no normal, never groove
-  std::optional<Eigen::Vector3f> viewpoint;  ///< overrides the PCD VIEWPOINT (cloud frame, m)
+/// "robust" or "paper", as in `--method` and report.json.
+GT_API const char* to_string(Method method);
 
-  // Detection.
-  bool threshold_auto = false;   ///< Otsu on log(D) instead of a fixed threshold
-  double threshold = 4.5;        ///< descriptor threshold (deg^2); paper range 4.5-5
-  int min_component = 50;        ///< connected groove parts smaller than this are dropped (points)
-  double link_distance = 0.0;    ///< max gap inside one groove component (m); 0 = radius
-
-  // Trajectory.
-  int slices = 50;               ///< equal-width slices along the groove = waypoints
-  bool slices_given = false;     ///< slices was set (flag or config): robust uses it over step
-  double step = 0.002;           ///< robust: waypoint spacing along the seam (m)
-  int max_seams = 1;             ///< robust: seams exported as trajectories, best first
+/// The paper method's own parameters (`--method paper`).
+struct PaperParams {
+  bool smooth = true;          ///< run MLS smoothing before normals
+  double mls_radius = 0.003;   ///< MLS search radius (m)
+  int mls_order = 2;           ///< MLS polynomial order: 1 = plane projection, 2 = quadric
+  double radius = 0.003;       ///< neighbourhood radius r for normals and the GFH (m)
+  int min_neighbors = 5;       ///< fewer neighbours within r: no normal, never groove
+  bool threshold_auto = false; ///< Otsu on log(D) instead of a fixed threshold
+  double threshold = 4.5;      ///< descriptor threshold (deg^2); paper range 4.5-5
+  int min_component = 50;      ///< connected groove parts smaller than this are dropped (points)
+  double link_distance = 0.0;  ///< max gap inside one groove component (m); 0 = radius
+  int slices = 50;             ///< equal-width slices along the groove = waypoints
   int median_max_iterations = 1000;
   double median_tolerance = 1e-7;  ///< Weiszfeld stop: step below this (m), the paper's 1e-4 mm
+};
 
-  // Robot program (URScript).
+/// The robust method's parameters (`--method robust`, docs/method-robust.md). The defaults are
+/// the one configuration used on every shape, distance, tilt and resolution; only `step`,
+/// `slices` and `max_seams` are run parameters (flags).
+struct RobustParams {
+  /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
+  /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
+  double scale = 0.010;
+  double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
+  double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
+  double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
+  double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
+  double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
+  double min_length = 0.015;  ///< seams shorter than this are rejected (m)
+  double step = 0.002;        ///< waypoint spacing along the seam (m)
+  int slices = 0;             ///< > 0: this many equal arc-length parts instead of `step`
+  int max_seams = 1;          ///< seams exported as trajectories, best first
+};
+
+/// The robot program's motion and arc settings (URScript, urscript.hpp).
+struct ProgramParams {
   double approach_offset = 0.05;  ///< approach/retreat distance along -tool z (m)
   double approach_speed = 0.1;    ///< m/s for approach and retreat moves
   double weld_speed = 0.008;      ///< m/s along the seam
@@ -45,6 +63,20 @@ struct Params {
   double blend_radius = 0.002;    ///< requested movep blend radius (m), capped per segment
   int arc_output = 0;             ///< standard digital output that switches the arc
   double arc_delay = 0.5;         ///< s to wait after arc on before moving
+};
+
+/// Parameters of a run: what both methods share, then each method's own (only the chosen
+/// method's are used; the CLI warns about flags of the other).
+struct Params {
+  Method method = Method::robust;
+  std::string backend = "auto";  ///< "auto", "cpu" or "opencl"
+  std::string device;            ///< OpenCL device: index or name part; empty = first GPU, else first
+  double units_scale = 1.0;      ///< input coordinates * units_scale = metres (mm: 0.001)
+  std::optional<Eigen::Vector3f> viewpoint;  ///< overrides the PCD VIEWPOINT (cloud frame, m)
+
+  PaperParams paper;
+  RobustParams robust;
+  ProgramParams program;
 
   // Frames: robot base frame output when both are given (files, see docs/frames.md).
   std::string hand_eye_file;      ///< T_flange_camera

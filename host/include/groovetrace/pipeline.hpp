@@ -1,13 +1,17 @@
 #pragma once
-// The whole `run`: features, detection, trajectory, frames, and the output files.
+// The whole `run`: the chosen method's detection, the trajectories, frames, and the output
+// files. Every 3-D quantity is in metres; per-point vectors are in input order.
 
 #include <groovetrace/cloud.hpp>
-#include <groovetrace/paper.hpp>
+#include <groovetrace/export.hpp>
 #include <groovetrace/features.hpp>
+#include <groovetrace/paper.hpp>
 #include <groovetrace/params.hpp>
 #include <groovetrace/robust.hpp>
 #include <groovetrace/trajectory.hpp>
+#include <groovetrace/version.hpp>
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <utility>
@@ -15,47 +19,56 @@
 
 namespace groovetrace {
 
-/// Everything a run computed, in input order.
+/// What only the paper method computes.
+struct PaperDetail {
+  Cloud smoothed;       ///< the input after MLS (metres, cloud frame)
+  Detection detection;  ///< threshold, kept components (D in deg^2)
+};
+
+/// Everything a run computed. The shared fields are filled by both methods; `paper` or
+/// `robust` holds the chosen method's own results (the other stays empty).
 struct RunResult {
-  Cloud smoothed;                  ///< after MLS (metres, cloud frame)
-  Normals normals;                 ///< oriented to the viewpoint
-  Eigen::Vector3f benchmark_normal = Eigen::Vector3f::Zero();  ///< u_b
-  std::vector<float> descriptor;   ///< D (deg^2)
-  Detection detection;
-  Trajectory trajectory;           ///< camera frame, or base frame when frames were given
-  /// --method robust: the seams after the best, up to max_seams - 1, same frame as trajectory
-  /// (written as trajectory_1.csv, ...).
-  std::vector<Trajectory> extra_trajectories;
-  /// --method robust: candidates, seams and scores (descriptor then holds the concavity, mm).
-  RobustDetection robust;
+  Method method = Method::robust;
+  std::vector<std::uint8_t> groove;  ///< per input point: 1 = groove
+  /// Per input point, unit, towards the viewpoint (cloud frame): paper: the PCA normal at
+  /// `radius`; robust: the crease map's plane normal at the groove's scale. NaN = none.
+  Normals normals;
+  /// Per input point, in `score_unit`, NaN = none: paper: the descriptor D (deg^2); robust:
+  /// the concavity (mm). Written as annotated.pcd's `descriptor` field.
+  std::vector<float> score;
+  std::string score_unit;  ///< "deg^2" or "mm"
+  /// The exported seams' torch paths, best first (written as trajectory.csv, then
+  /// trajectory_1.csv, ...); camera frame, or base frame when frames were given. Never empty
+  /// after a successful run.
+  std::vector<Trajectory> trajectories;
   std::vector<std::pair<std::string, double>> timings_ms;  ///< per stage, in order
   std::vector<std::string> warnings;
-  std::string backend, device;
+  std::string backend, device;  ///< the backend that ran and its device
+  PaperDetail paper;            ///< --method paper only
+  RobustDetection robust;       ///< --method robust only: candidates, seams and scores
 };
 
 /// Called after each stage with its name and duration (ms), e.g. to print progress.
 using StageCallback = std::function<void(const std::string& stage, double ms)>;
 
-/// Runs smoothing, normals, descriptor, detection and trajectory on `cloud` (metres).
-/// Throws NoGrooveError when no groove is found, UsageError for bad parameters.
-RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend& backend,
-                       const StageCallback& on_stage = {});
+/// Runs the method of `params` on `cloud` (metres): detection and trajectories, moved into the
+/// base frame when calibration files are given. Throws NoGrooveError when no groove is found,
+/// UsageError for bad parameters, InputError for unreadable calibration files.
+GT_API RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend& backend,
+                              const StageCallback& on_stage = {});
 
 /// Checks parameter ranges; throws UsageError naming the offending parameter.
-void validate(const Params& params);
+GT_API void validate(const Params& params);
 
 /// The output files of a run, as bytes, keyed by file name (annotated.pcd, trajectory.csv,
 /// trajectory.json, program.script, report.json; with --max-seams N > 1 also
 /// trajectory_K.csv, trajectory_K.json and program_K.script for the K-th next seam).
-std::vector<std::pair<std::string, std::string>> render_outputs(
+GT_API std::vector<std::pair<std::string, std::string>> render_outputs(
     const Cloud& input, const RunResult& result, const Params& params,
     const std::string& input_path, double total_ms);
 
 /// Writes each rendered file into `out_dir` atomically (creating the directory).
-void write_outputs(const std::string& out_dir,
-                   const std::vector<std::pair<std::string, std::string>>& files);
-
-/// Library version string.
-const char* version();
+GT_API void write_outputs(const std::string& out_dir,
+                          const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace groovetrace

@@ -12,28 +12,12 @@
 #include <functional>
 #include <groovetrace/cloud.hpp>
 #include <groovetrace/features.hpp>
+#include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <string>
 #include <vector>
 
 namespace groovetrace {
-
-/// Settings of the robust method. The defaults are the one configuration used on every shape,
-/// distance, tilt and resolution; only `step`, `slices` and `max_seams` are run parameters.
-struct RobustParams {
-  /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
-  /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
-  double scale = 0.010;
-  double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
-  double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
-  double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
-  double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
-  double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
-  double min_length = 0.015;  ///< seams shorter than this are rejected (m)
-  double step = 0.002;        ///< waypoint spacing along the seam (m)
-  int slices = 0;             ///< > 0: this many equal arc-length parts instead of `step`
-  int max_seams = 1;          ///< seams exported as trajectories, best first
-};
 
 // --- Stage 1: candidates ------------------------------------------------------------------
 

@@ -1,6 +1,7 @@
 #pragma once
 // Text forms of a trajectory that other tools read.
 
+#include <groovetrace/export.hpp>
 #include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
 
@@ -10,10 +11,10 @@ namespace groovetrace {
 
 /// CSV with header `idx,x_m,y_m,z_m,qx,qy,qz,qw,rx,ry,rz`: positions (m) and orientation
 /// (quaternion x,y,z,w and UR rotation vector, rad) of each waypoint in trajectory.frame.
-std::string trajectory_csv(const Trajectory& trajectory);
+GT_API std::string trajectory_csv(const Trajectory& trajectory);
 
 /// JSON with the frame name, units, tool-frame convention, the parameters of the run and,
 /// per waypoint: position_m, quaternion_xyzw, rotation_vector_rad, euler_zyx_deg, support.
-std::string trajectory_json(const Trajectory& trajectory, const Params& params);
+GT_API std::string trajectory_json(const Trajectory& trajectory, const Params& params);
 
 }  // namespace groovetrace

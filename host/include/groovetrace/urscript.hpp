@@ -14,9 +14,9 @@ namespace groovetrace {
 /// params.weld_speed with blend radius min(params.blend_radius, 0.4 * shorter neighbouring
 /// segment) (0 at the last), arc off, retreat along -tool z. Poses are the trajectory's
 /// positions (m) and rotation vectors (rad) in its frame (meant to be the robot base).
-std::string urscript_program(const Trajectory& trajectory, const Params& params);
+GT_API std::string urscript_program(const Trajectory& trajectory, const ProgramParams& params);
 
 /// Blend radius (m) at waypoint i, as described above.
-double blend_radius_at(const Trajectory& trajectory, std::size_t i, double requested);
+GT_API double blend_radius_at(const Trajectory& trajectory, std::size_t i, double requested);
 
 }  // namespace groovetrace

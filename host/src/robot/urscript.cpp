@@ -32,7 +32,7 @@ std::string pose(const Eigen::Vector3d& position, const Eigen::Vector3d& rotatio
          fixed(rotation_vector.z()) + "]";
 }
 
-void check_params(const Params& p) {
+void check_params(const ProgramParams& p) {
   auto positive = [](double v, const char* name) {
     if (!(std::isfinite(v) && v > 0.0)) {
       throw UsageError(std::string(name) + " must be positive (got " + fixed(v) + ")");
@@ -70,7 +70,7 @@ double blend_radius_at(const Trajectory& trajectory, std::size_t i, double reque
   return std::max(0.0, std::min(requested, 0.4 * std::min(before, after)));
 }
 
-std::string urscript_program(const Trajectory& trajectory, const Params& params) {
+std::string urscript_program(const Trajectory& trajectory, const ProgramParams& params) {
   check_params(params);
   const auto& w = trajectory.waypoints;
   if (w.empty()) throw NoGrooveError("no waypoints: nothing to weld");

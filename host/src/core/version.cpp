@@ -1,0 +1,7 @@
+#include <groovetrace/version.hpp>
+
+namespace groovetrace {
+
+const char* version() { return GROOVETRACE_VERSION; }
+
+}  // namespace groovetrace

@@ -1,0 +1,165 @@
+// The files of a run: annotated cloud, trajectories, robot programs and report.json, rendered
+// as bytes first and then each written atomically.
+
+#include <cmath>
+#include <filesystem>
+#include <groovetrace/cloud_io.hpp>
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
+#include <groovetrace/pipeline.hpp>
+#include <groovetrace/trajectory_io.hpp>
+#include <groovetrace/urscript.hpp>
+#include <nlohmann/json.hpp>
+
+namespace groovetrace {
+namespace {
+
+using nlohmann::json;
+
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json seam_json(const SeamCandidate& s, std::size_t rank, const json& file) {
+  auto num = finite_or_null;
+  return {{"rank", rank},
+          {"accepted", s.accepted},
+          {"reason", s.reason},
+          {"score", num(s.score)},
+          {"length_m", num(s.length)},
+          {"closed", s.closed},
+          {"corners", s.curve.corners.size()},
+          {"sections", s.sections.size()},
+          {"ok_fraction", num(s.ok_fraction)},
+          {"fit_quality", num(s.fit_quality)},
+          {"consistency", num(s.consistency)},
+          {"width_m", num(s.width)},
+          {"depth_m", num(s.depth)},
+          {"opening_deg", num(s.opening_deg)},
+          {"file", file}};
+}
+
+// report.json "robust": the candidate threshold and every candidate seam with its score
+// (docs/method-robust.md, "Score"), best first; `file` names the trajectory written for it.
+json robust_report(const RobustDetection& rd, int max_seams) {
+  json seams = json::array();
+  int exported = 0;
+  for (std::size_t k = 0; k < rd.seams.size(); ++k) {
+    const SeamCandidate& s = rd.seams[k];
+    json file = nullptr;
+    if (s.accepted && exported < max_seams) {
+      file = exported == 0 ? "trajectory.csv" : "trajectory_" + std::to_string(exported) + ".csv";
+      ++exported;
+    }
+    seams.push_back(seam_json(s, k, file));
+  }
+  return {{"concavity_threshold_m", rd.threshold},
+          {"concavity_sigma_m", rd.noise_sigma},
+          {"candidate_voxels", rd.candidates},
+          {"crease_nodes", rd.nodes},
+          {"confirmed_nodes", rd.confirmed_nodes},
+          {"score", "length_mm * ok_fraction * fit_quality * consistency"},
+          {"seams", seams}};
+}
+
+// report.json "detection". Robust: components are the accepted seams, their sizes the
+// sections (stations) of each; paper: the kept connected parts and their point counts.
+json detection_report(const RunResult& result, const Params& params) {
+  const Eigen::Vector3f ub = benchmark_normal(result.normals);
+  json d = {{"threshold_deg2", nullptr}, {"threshold_mode", "robust_concavity_mm"}};
+  if (result.method == Method::paper) {
+    const Detection& pd = result.paper.detection;
+    d["threshold_deg2"] = pd.threshold;
+    d["threshold_mode"] = params.paper.threshold_auto ? "otsu_log_descriptor" : "fixed";
+    d["components"] = pd.components;
+    d["component_sizes"] = pd.component_sizes;
+  } else {
+    std::vector<std::size_t> sizes;
+    for (const SeamCandidate& s : result.robust.seams) {
+      if (s.accepted) sizes.push_back(s.sections.size());
+    }
+    d["components"] = sizes.size();
+    d["component_sizes"] = sizes;
+  }
+  d["benchmark_normal"] = {ub.x(), ub.y(), ub.z()};
+  return d;
+}
+
+json points_report(const Cloud& input, const RunResult& result) {
+  std::size_t with_normal = 0, groove = 0;
+  for (std::size_t i = 0; i < result.normals.size(); ++i) {
+    with_normal += result.normals.valid(i) ? 1 : 0;
+    groove += result.groove[i];
+  }
+  const std::size_t above = result.method == Method::paper
+                                ? result.paper.detection.above_threshold
+                                : result.robust.candidates;
+  return {{"total", input.size()},          {"width", input.width},
+          {"height", input.height},         {"valid", input.count_valid()},
+          {"with_normal", with_normal},     {"above_threshold", above},
+          {"groove", groove}};
+}
+
+std::string report_json(const Cloud& input, const RunResult& result, const Params& params,
+                        const std::string& input_path, double total_ms) {
+  json timings = json::object();
+  for (const auto& [stage, ms] : result.timings_ms) timings[stage] = ms;
+  timings["total"] = total_ms;
+  const Trajectory& best = result.trajectories.front();
+  json report = {{"version", version()},
+                 {"input", input_path},
+                 {"method", to_string(result.method)},
+                 {"backend", result.backend},
+                 {"device", result.device},
+                 {"parameters", json::parse(params_json(params))},
+                 {"points", points_report(input, result)},
+                 {"detection", detection_report(result, params)},
+                 {"trajectory",
+                  {{"frame", best.frame},
+                   {"waypoints", best.waypoints.size()},
+                   {"length_m", best.length}}},
+                 {"timings_ms", timings},
+                 {"warnings", result.warnings}};
+  if (result.method == Method::robust) {
+    report["robust"] = robust_report(result.robust, params.robust.max_seams);
+  }
+  return report.dump(2) + "\n";
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& input,
+                                                                const RunResult& result,
+                                                                const Params& params,
+                                                                const std::string& input_path,
+                                                                double total_ms) {
+  if (result.trajectories.empty()) throw InternalError("render_outputs: no trajectory");
+  std::vector<std::pair<std::string, std::string>> files;
+  Annotations ann;
+  ann.normals = &result.normals;
+  ann.descriptor = &result.score;
+  ann.groove = &result.groove;
+  files.emplace_back("annotated.pcd", annotated_pcd_bytes(input, ann));
+  for (std::size_t k = 0; k < result.trajectories.size(); ++k) {
+    const std::string n = k == 0 ? "" : "_" + std::to_string(k);
+    const Trajectory& t = result.trajectories[k];
+    files.emplace_back("trajectory" + n + ".csv", trajectory_csv(t));
+    files.emplace_back("trajectory" + n + ".json", trajectory_json(t, params));
+    files.emplace_back("program" + n + ".script", urscript_program(t, params.program));
+  }
+  files.emplace_back("report.json", report_json(input, result, params, input_path, total_ms));
+  return files;
+}
+
+void write_outputs(const std::string& out_dir,
+                   const std::vector<std::pair<std::string, std::string>>& files) {
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec || !std::filesystem::is_directory(out_dir)) {
+    throw InputError("cannot create output directory " + out_dir +
+                     (ec ? ": " + ec.message() : ": not a directory"));
+  }
+  for (const auto& [name, bytes] : files) {
+    write_file_atomic((std::filesystem::path(out_dir) / name).string(), bytes);
+  }
+}
+
+}  // namespace groovetrace

@@ -1,0 +1,85 @@
+// The parameter table: each key writes its own method's field, reports the other method's
+// keys, and round-trips through report.json's text.
+#include <gtest/gtest.h>
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
+#include <groovetrace/pipeline.hpp>
+
+#include <nlohmann/json.hpp>
+#include <set>
+
+namespace groovetrace {
+namespace {
+
+TEST(Params, MethodIsAnEnumWithItsCliName) {
+  Params p;
+  EXPECT_EQ(p.method, Method::robust);
+  set_param(p, "method", "paper");
+  EXPECT_EQ(p.method, Method::paper);
+  EXPECT_STREQ(to_string(p.method), "paper");
+  EXPECT_THROW(set_param(p, "method", "Paper"), UsageError);
+}
+
+TEST(Params, EachKeyWritesItsOwnMethodsField) {
+  Params p;
+  EXPECT_EQ(p.paper.slices, 50);
+  EXPECT_EQ(p.robust.slices, 0);  // the robust method spaces waypoints by `step` unless asked
+  set_param(p, "radius", "0.004");
+  set_param(p, "step", "0.003");
+  set_param(p, "max-seams", "2");
+  set_param(p, "weld_speed", "0.01");
+  EXPECT_DOUBLE_EQ(p.paper.radius, 0.004);
+  EXPECT_DOUBLE_EQ(p.robust.step, 0.003);
+  EXPECT_EQ(p.robust.max_seams, 2);
+  EXPECT_DOUBLE_EQ(p.program.weld_speed, 0.01);
+  set_param(p, "slices", "20");  // both methods cut waypoints by it when given
+  EXPECT_EQ(p.paper.slices, 20);
+  EXPECT_EQ(p.robust.slices, 20);
+}
+
+TEST(Params, OtherMethodsKeysAreNamed) {
+  Params robust;
+  EXPECT_EQ(other_method_warning(robust, "threshold"),
+            "threshold belongs to the paper method; the robust method ignores it");
+  EXPECT_EQ(other_method_warning(robust, "mls-radius"),
+            "mls_radius belongs to the paper method; the robust method ignores it");
+  EXPECT_EQ(other_method_warning(robust, "step"), "");
+  EXPECT_EQ(other_method_warning(robust, "slices"), "");
+  EXPECT_EQ(other_method_warning(robust, "weld_speed"), "");
+  Params paper;
+  paper.method = Method::paper;
+  EXPECT_EQ(other_method_warning(paper, "max_seams"),
+            "max_seams belongs to the robust method; the paper method ignores it");
+  EXPECT_EQ(other_method_warning(paper, "radius"), "");
+}
+
+TEST(Params, JsonNamesEveryKeyOnceAndValidates) {
+  Params p;
+  set_param(p, "threshold", "auto");
+  set_param(p, "viewpoint", "0.1,0.2,0.3");
+  const auto j = nlohmann::json::parse(params_json(p));
+  std::set<std::string> keys;
+  for (const auto& spec : param_specs()) {
+    EXPECT_TRUE(keys.insert(spec.key).second) << spec.key;
+    EXPECT_TRUE(j.contains(spec.key)) << spec.key;
+  }
+  EXPECT_EQ(j.size(), keys.size());
+  EXPECT_EQ(j["threshold"], "auto");
+  EXPECT_EQ(j["method"], "robust");
+  EXPECT_NO_THROW(validate(p));
+}
+
+TEST(Params, ValidateRefusesWhatTheFlagsWould) {
+  Params p;
+  p.robust.slices = 1;  // set from code, below the flag's range
+  EXPECT_THROW(validate(p), UsageError);
+  Params q;
+  q.paper.radius = 3.0;  // metres: meant as mm
+  EXPECT_THROW(validate(q), UsageError);
+  Params r;
+  r.hand_eye_file = "hand_eye.yaml";  // without the flange pose
+  EXPECT_THROW(validate(r), UsageError);
+}
+
+}  // namespace
+}  // namespace groovetrace
