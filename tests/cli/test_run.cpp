@@ -171,6 +171,14 @@ TEST_F(CliRun, FlagsOfTheOtherMethodAreWarnedAbout) {
   const auto report2 = nlohmann::json::parse(test::read_text(out2 / "report.json"));
   EXPECT_EQ(report2["warnings"], nlohmann::json::array({radius_warning}));  // once, not twice
   EXPECT_EQ(report2["method"], "robust");
+
+  // trajectory.json says which axis each method's torch follows.
+  const auto tool_frame = [](const fs::path& dir) {
+    return nlohmann::json::parse(test::read_text(dir / "trajectory.json"))["tool_frame"]
+        .get<std::string>();
+  };
+  EXPECT_NE(tool_frame(out).find("-mean surface normal of the slice"), std::string::npos);
+  EXPECT_NE(tool_frame(out2).find("-bisector of the two fitted walls"), std::string::npos);
 }
 
 }  // namespace

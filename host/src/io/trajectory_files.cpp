@@ -1,5 +1,5 @@
 #include <groovetrace/config.hpp>
-#include <groovetrace/pipeline.hpp>
+#include <groovetrace/version.hpp>
 #include <groovetrace/trajectory_io.hpp>
 
 #include <cstdio>
@@ -21,6 +21,17 @@ std::string trajectory_csv(const Trajectory& trajectory) {
   return out;
 }
 
+namespace {
+
+std::string tool_frame_text(Method method) {
+  const char* z = method == Method::robust ? "-bisector of the two fitted walls"
+                                           : "-mean surface normal of the slice";
+  return std::string("z along the torch into the workpiece (") + z +
+         "), x along the travel direction, y = z cross x";
+}
+
+}  // namespace
+
 std::string trajectory_json(const Trajectory& trajectory, const Params& params) {
   using nlohmann::json;
   auto vec = [](const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); };
@@ -39,9 +50,7 @@ std::string trajectory_json(const Trajectory& trajectory, const Params& params) 
       {"version", version()},
       {"frame", trajectory.frame},
       {"units", {{"position", "m"}, {"rotation_vector", "rad"}, {"euler", "deg"}}},
-      {"tool_frame",
-       "z along the torch into the workpiece (-surface normal), x along the travel direction, "
-       "y = z cross x"},
+      {"tool_frame", tool_frame_text(params.method)},
       {"euler_convention", "euler_zyx_deg = [yaw, pitch, roll], R = Rz(yaw) Ry(pitch) Rx(roll)"},
       {"direction", vec(trajectory.direction)},
       {"length_m", trajectory.length},
