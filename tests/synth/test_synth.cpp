@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <groovetrace/error.hpp>
 #include <groovetrace/synth.hpp>
 #include <limits>
@@ -570,6 +571,37 @@ TEST(SynthFiles, TruthRoundTrip) {
   EXPECT_EQ(gt::truth_json(t, "scan.pcd", "scan.labels.pcd"),
             gt::truth_json(s.truth, "scan.pcd", "scan.labels.pcd"));
   EXPECT_THROW(gt::read_synth_truth(dir + "/missing.pcd"), gt::InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SynthFiles, LabelsAreReadWithThePcdChecks) {
+  // The labels file goes through the scan reader's checks: a cut file or one of another
+  // size is an InputError naming it.
+  gt::SynthParams p;
+  p.width = 64;
+  p.height = 48;
+  p.noise = false;
+  const std::string dir = temp_dir("labels");
+  const gt::SynthScan s = gt::render(p);
+  const gt::SynthFiles f = gt::write_synth_scan(s, dir + "/scan.pcd");
+  const std::string labels = gt::labels_pcd_bytes(s.truth);
+  const auto expect_rejected = [&](const std::string& bytes, const std::string& reason) {
+    std::ofstream(f.labels, std::ios::binary) << bytes;
+    try {
+      gt::read_synth_truth(f.scan);
+      ADD_FAILURE() << "accepted; expected '" << reason << "'";
+    } catch (const gt::InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("scan.labels.pcd"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(reason), std::string::npos) << msg;
+    }
+  };
+  expect_rejected(labels.substr(0, labels.size() - 1), "truncated PCD data");
+  gt::SynthTruth other = s.truth;
+  other.camera.height = 32;
+  other.label.resize(64 * 32);
+  other.valid.resize(64 * 32);
+  expect_rejected(gt::labels_pcd_bytes(other), "is not a labels file for a 64x48 scan");
   std::filesystem::remove_all(dir);
 }
 

@@ -87,7 +87,7 @@ struct RunOutput {
   std::vector<std::pair<std::string, double>> stage_ms;  ///< report.json stage timings
 };
 
-/// Reads annotated.pcd (binary or ascii PCD with a `groove` field), trajectory.csv (header
+/// Reads annotated.pcd (a PCD of any DATA kind with a `groove` field), trajectory.csv (header
 /// `idx,x_m,y_m,z_m,qx,qy,qz,qw,...`), and, when present, trajectory.json and report.json.
 /// Throws InputError when annotated.pcd is missing or malformed, or trajectory.csv malformed.
 RunOutput read_run_output(const std::string& result_dir);
