@@ -13,10 +13,11 @@
 #include <filesystem>
 #include <fstream>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "synth/internal.hpp"
 
 namespace gt = groovetrace;
 

@@ -11,12 +11,13 @@
 #include <algorithm>
 #include <cmath>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {

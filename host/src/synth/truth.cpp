@@ -5,13 +5,13 @@
 #include <fstream>
 #include <groovetrace/cloud_io.hpp>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "io/pcd.hpp"
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {
