@@ -102,7 +102,7 @@ std::string temp_dir(const std::string& name) {
 TEST(SynthCamera, D415Intrinsics) {
   const gt::CameraModel c = gt::d415_camera(1280, 720);
   EXPECT_NEAR(c.fx, 640.0 / std::tan(32.5 * kPi / 180.0), 1e-9);
-  EXPECT_NEAR(c.fx, 1004.6, 0.1);  // DESIGN.md: about 1005 px
+  EXPECT_NEAR(c.fx, 1004.6, 0.1);  // docs/design.md: about 1005 px
   EXPECT_NEAR(c.fy, 360.0 / std::tan(20.0 * kPi / 180.0), 1e-9);
   EXPECT_DOUBLE_EQ(c.cx, 639.5);
   EXPECT_DOUBLE_EQ(c.cy, 359.5);
@@ -351,7 +351,7 @@ TEST(SynthSensor, DepthNoiseMatchesD415Formula) {
     for (std::size_t i = 0; i < clean.cloud.size(); ++i) {
       if (!noisy.cloud.valid(i) || clean.truth.label[i]) continue;  // the flats
       const double z = clean.cloud.z[i], r = noisy.cloud.z[i] - z;
-      const double sigma = z * z * 0.08 / (fx * 0.055);  // DESIGN.md
+      const double sigma = z * z * 0.08 / (fx * 0.055);  // docs/design.md
       sum2 += r * r;
       mean += r;
       expected2 += sigma * sigma;
@@ -418,7 +418,7 @@ TEST(SynthSensor, UndulationIsCorrelatedAndSized) {
   const double std_mm = std::sqrt(sum2 / n) * 1e3;
   std::printf("undulation at 0.5 m: std %.3f mm, neighbour correlation %.3f, at 200 px %.3f\n",
               std_mm, lag / sum2, far / sum2);
-  // DESIGN.md: about 0.45 mm std on flats of a real D415 scan.
+  // docs/design.md: about 0.45 mm std on flats of a real D415 scan.
   EXPECT_NEAR(std_mm, 0.45, 0.07);
   EXPECT_GT(lag / sum2, 0.95);
   EXPECT_LT(std::abs(far / sum2), 0.3);

@@ -1,6 +1,7 @@
 #pragma once
-// Accuracy of a detection and its trajectory against synthetic ground truth (DESIGN.md,
-// "Metrics"): the paper's IoU lambda, plus waypoint errors against the true root line.
+// Accuracy of a detection and its trajectory against synthetic ground truth: the paper's IoU
+// lambda, plus waypoint errors against the true root line (docs/synthetic-scans.md,
+// "`groovetrace eval`").
 //
 // Frames: everything is compared in the scan's camera frame (metres). A trajectory written in
 // the robot base frame (`run --hand-eye ...`) cannot be compared; evaluate_files notes it.

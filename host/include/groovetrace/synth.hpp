@@ -3,7 +3,7 @@
 //
 // No public labelled scans of V-grooves exist, so accuracy claims rest on these: an analytic
 // workpiece on a welding table is ray cast through a pinhole camera, then a D415 sensor model
-// (DESIGN.md, "RealSense D415 facts") turns the ideal depth into what the camera returns.
+// (docs/design.md, the D415 sensor facts) turns the ideal depth into what the camera returns.
 //
 // Frames. The workpiece frame W: the table is the plane z = 0, z points up out of the table,
 // the seam runs along +x through the origin's vertical (x, y in the table plane). The camera
@@ -40,7 +40,7 @@ std::vector<std::string> shape_names();
 
 /// Which sensor effects the D415 model applies (all only when SynthParams::noise is on).
 struct SensorEffects {
-  bool depth_noise = true;      ///< per-pixel disparity noise (DESIGN.md depth RMS formula)
+  bool depth_noise = true;      ///< per-pixel disparity noise (docs/design.md depth RMS formula)
   bool undulation = true;       ///< spatially correlated disparity error over 5-20 mm
   bool blur = true;             ///< stereo matching window averages disparity across creases
   bool flying_pixels = true;    ///< depths between foreground and background at jumps
@@ -63,7 +63,7 @@ SensorEffects parse_effects(const std::string& list);
 /// The comma-separated names of the effects that are on ("none" if no effect is on).
 std::string effects_string(const SensorEffects& effects);
 
-/// D415 constants of the sensor model. Defaults follow DESIGN.md; change them to model
+/// D415 constants of the sensor model. Defaults follow docs/design.md; change them to model
 /// another stereo camera.
 struct SensorModel {
   double hfov_deg = 65.0;              ///< horizontal field of view at every resolution (deg)

@@ -1,4 +1,5 @@
-// Metrics of a detection and trajectory against synthetic ground truth (DESIGN.md "Metrics").
+// Metrics of a detection and trajectory against synthetic ground truth
+// (docs/synthetic-scans.md, "`groovetrace eval`").
 
 #include <algorithm>
 #include <cmath>
