@@ -4,10 +4,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <groovetrace/cloud_io.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/eval.hpp>
 #include <groovetrace/synth.hpp>
@@ -174,17 +176,13 @@ TEST(Eval, ReadsARunDirectory) {
   gt::write_synth_scan(scan, scan_path);
 
   {
-    std::ofstream pcd(dir / "out" / "annotated.pcd", std::ios::binary);
-    pcd << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z normal_x normal_y normal_z descriptor groove\n"
-           "SIZE 4 4 4 4 4 4 4 1\nTYPE F F F F F F F U\nCOUNT 1 1 1 1 1 1 1 1\n"
-        << "WIDTH " << p.width << "\nHEIGHT " << p.height << "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
-        << scan.cloud.size() << "\nDATA binary\n";
-    for (std::size_t i = 0; i < scan.cloud.size(); ++i) {
-      const float f[7] = {scan.cloud.x[i], scan.cloud.y[i], scan.cloud.z[i], 0, 0, -1, 1};
-      pcd.write(reinterpret_cast<const char*>(f), sizeof f);
-      const char g = static_cast<char>(scan.truth.label[i]);
-      pcd.write(&g, 1);
-    }
+    gt::Normals normals;
+    normals.resize(scan.cloud.size());
+    std::fill(normals.z.begin(), normals.z.end(), -1.0f);
+    const std::vector<float> descriptor(scan.cloud.size(), 1.0f);
+    gt::write_file_atomic(
+        (dir / "out" / "annotated.pcd").string(),
+        gt::annotated_pcd_bytes(scan.cloud, {&normals, &descriptor, &scan.truth.label}));
   }
   const gt::Seam& seam = scan.truth.seams[0];
   {
@@ -228,6 +226,46 @@ TEST(Eval, ReadsARunDirectory) {
   std::ofstream(dir / "out" / "trajectory.json") << R"({"frame": "base"})";
   EXPECT_FALSE(gt::evaluate_files(scan_path, (dir / "out").string()).notes.empty());
   EXPECT_THROW(gt::evaluate_files(scan_path, (dir / "nowhere").string()), gt::InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Eval, MalformedAnnotatedPcdIsAnInputError) {
+  // annotated.pcd goes through the scan reader's checks: what eval used to read as zeros or
+  // guess around (words in ascii data, no POINTS, a shape that is not POINTS) is rejected,
+  // with the file and the reason on one line.
+  gt::SynthParams p;
+  p.width = 64;
+  p.height = 48;
+  p.noise = false;
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gt-evalbad-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "out");
+  const std::string scan_path = (dir / "scan.pcd").string();
+  gt::write_synth_scan(gt::render(p), scan_path);
+  const std::string head = "VERSION 0.7\nFIELDS x y z groove\nSIZE 4 4 4 1\nTYPE F F F U\n";
+  std::string rows;
+  for (int i = 0; i < 64 * 48; ++i) rows += i == 100 ? "0 0 0.4 yes\n" : "0 0 0.4 0\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {head + "WIDTH 64\nHEIGHT 48\nPOINTS 3072\nDATA ascii\n" + rows, "'yes' is not a number"},
+      {head + "WIDTH 64\nHEIGHT 48\nDATA ascii\n" + rows, "no POINTS line"},
+      {head + "WIDTH 64\nHEIGHT 47\nPOINTS 3072\nDATA ascii\n" + rows,
+       "WIDTH x HEIGHT (64 x 47) is not POINTS (3072)"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n",
+       "has no groove field (fields: x y z)"},
+  };
+  for (const auto& [text, reason] : cases) {
+    std::ofstream(dir / "out" / "annotated.pcd", std::ios::binary) << text;
+    try {
+      gt::evaluate_files(scan_path, (dir / "out").string());
+      ADD_FAILURE() << "accepted; expected '" << reason << "'";
+    } catch (const gt::InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("eval: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find("annotated.pcd"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(reason), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "io/pcd.hpp"
+
 namespace groovetrace {
 namespace {
 
@@ -660,6 +662,61 @@ TEST_F(CloudIo, AnnotatedPcdIsReadByPcl) {
   EXPECT_EQ(back.viewpoint, c.viewpoint);
   EXPECT_EQ(back.z[5], c.z[5]);
   EXPECT_FALSE(back.valid(4));
+}
+
+TEST_F(CloudIo, AnnotatedPcdFieldsReadBack) {
+  // read_pcd_fields gives every field of COUNT 1 by name, with the header's shape.
+  const Cloud c = organized_cloud();
+  Normals normals;
+  normals.resize(6);
+  normals.z[1] = -0.8f;
+  const std::vector<float> descriptor = {1.0f, 2.5f, kNaN, 4.0f, kNaN, 6.0f};
+  const std::vector<std::uint8_t> groove = {0, 1, 0, 1, 0, 7};
+  const fs::path p =
+      file("annotated.pcd", annotated_pcd_bytes(c, {&normals, &descriptor, &groove}));
+  const io::PcdTable t = io::read_pcd_fields(p.string(), {"groove", "normal_z"});
+  EXPECT_EQ(t.width, 3u);
+  EXPECT_EQ(t.height, 2u);
+  EXPECT_EQ(t.viewpoint, c.viewpoint);
+  EXPECT_EQ(t.names, (std::vector<std::string>{"x", "y", "z", "normal_x", "normal_y", "normal_z",
+                                               "descriptor", "groove"}));
+  EXPECT_EQ(*t.column("groove"), (std::vector<float>{0, 1, 0, 1, 0, 1}));
+  EXPECT_EQ((*t.column("normal_z"))[1], -0.8f);
+  EXPECT_TRUE(std::isnan((*t.column("normal_z"))[0]));
+  EXPECT_EQ((*t.column("descriptor"))[1], 2.5f);
+  EXPECT_EQ((*t.column("z"))[5], c.z[5]);
+  EXPECT_EQ(t.column("intensity"), nullptr);
+}
+
+TEST_F(CloudIo, PcdFieldsHaveTheScanChecks) {
+  const auto expect_fails = [](const fs::path& p, std::vector<std::string> required,
+                               const std::string& phrase) {
+    try {
+      io::read_pcd_fields(p.string(), required);
+      ADD_FAILURE() << p << " was accepted; expected '" << phrase << "'";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(p.filename().string()), std::string::npos) << msg;
+      EXPECT_NE(msg.find(phrase), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  };
+  // No x/y/z needed here, but the named fields are.
+  const std::string labels =
+      "VERSION 0.7\nFIELDS label valid\nSIZE 1 1\nTYPE U U\nWIDTH 2\nPOINTS 2\n"
+      "DATA ascii\n1 0\n0 1\n";
+  const fs::path ok = file("labels.pcd", labels);
+  EXPECT_EQ(*io::read_pcd_fields(ok.string(), {"label"}).column("valid"),
+            (std::vector<float>{0, 1}));
+  expect_fails(ok, {"groove"}, "has no groove field (fields: label valid)");
+  expect_fails(file("cut.pcd", labels.substr(0, labels.size() - 2)), {},
+               "truncated PCD data: line 9 has 1 value, expected 2");
+  expect_fails(file("word.pcd", ascii_pcd("x y groove", 2, 1, 2, "1 2 0\n3 4 x\n")), {},
+               "malformed PCD data: line 13: 'x' is not a number");
+  expect_fails(dir_ / "missing.pcd", {}, "No such file");
+  const std::string histogram =
+      "VERSION 0.7\nFIELDS h\nSIZE 4\nTYPE F\nCOUNT 2\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2\n";
+  expect_fails(file("histogram.pcd", histogram), {"h"}, "field h has COUNT > 1");
 }
 
 TEST_F(CloudIo, AnnotatedPcdHeaderIsExact) {

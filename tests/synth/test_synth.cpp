@@ -11,11 +11,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "synth/internal.hpp"
 
 namespace gt = groovetrace;
 
@@ -100,7 +102,7 @@ std::string temp_dir(const std::string& name) {
 TEST(SynthCamera, D415Intrinsics) {
   const gt::CameraModel c = gt::d415_camera(1280, 720);
   EXPECT_NEAR(c.fx, 640.0 / std::tan(32.5 * kPi / 180.0), 1e-9);
-  EXPECT_NEAR(c.fx, 1004.6, 0.1);  // DESIGN.md: about 1005 px
+  EXPECT_NEAR(c.fx, 1004.6, 0.1);  // docs/design.md: about 1005 px
   EXPECT_NEAR(c.fy, 360.0 / std::tan(20.0 * kPi / 180.0), 1e-9);
   EXPECT_DOUBLE_EQ(c.cx, 639.5);
   EXPECT_DOUBLE_EQ(c.cy, 359.5);
@@ -349,7 +351,7 @@ TEST(SynthSensor, DepthNoiseMatchesD415Formula) {
     for (std::size_t i = 0; i < clean.cloud.size(); ++i) {
       if (!noisy.cloud.valid(i) || clean.truth.label[i]) continue;  // the flats
       const double z = clean.cloud.z[i], r = noisy.cloud.z[i] - z;
-      const double sigma = z * z * 0.08 / (fx * 0.055);  // DESIGN.md
+      const double sigma = z * z * 0.08 / (fx * 0.055);  // docs/design.md
       sum2 += r * r;
       mean += r;
       expected2 += sigma * sigma;
@@ -416,7 +418,7 @@ TEST(SynthSensor, UndulationIsCorrelatedAndSized) {
   const double std_mm = std::sqrt(sum2 / n) * 1e3;
   std::printf("undulation at 0.5 m: std %.3f mm, neighbour correlation %.3f, at 200 px %.3f\n",
               std_mm, lag / sum2, far / sum2);
-  // DESIGN.md: about 0.45 mm std on flats of a real D415 scan.
+  // docs/design.md: about 0.45 mm std on flats of a real D415 scan.
   EXPECT_NEAR(std_mm, 0.45, 0.07);
   EXPECT_GT(lag / sum2, 0.95);
   EXPECT_LT(std::abs(far / sum2), 0.3);
@@ -570,6 +572,37 @@ TEST(SynthFiles, TruthRoundTrip) {
   EXPECT_EQ(gt::truth_json(t, "scan.pcd", "scan.labels.pcd"),
             gt::truth_json(s.truth, "scan.pcd", "scan.labels.pcd"));
   EXPECT_THROW(gt::read_synth_truth(dir + "/missing.pcd"), gt::InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SynthFiles, LabelsAreReadWithThePcdChecks) {
+  // The labels file goes through the scan reader's checks: a cut file or one of another
+  // size is an InputError naming it.
+  gt::SynthParams p;
+  p.width = 64;
+  p.height = 48;
+  p.noise = false;
+  const std::string dir = temp_dir("labels");
+  const gt::SynthScan s = gt::render(p);
+  const gt::SynthFiles f = gt::write_synth_scan(s, dir + "/scan.pcd");
+  const std::string labels = gt::labels_pcd_bytes(s.truth);
+  const auto expect_rejected = [&](const std::string& bytes, const std::string& reason) {
+    std::ofstream(f.labels, std::ios::binary) << bytes;
+    try {
+      gt::read_synth_truth(f.scan);
+      ADD_FAILURE() << "accepted; expected '" << reason << "'";
+    } catch (const gt::InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("scan.labels.pcd"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(reason), std::string::npos) << msg;
+    }
+  };
+  expect_rejected(labels.substr(0, labels.size() - 1), "truncated PCD data");
+  gt::SynthTruth other = s.truth;
+  other.camera.height = 32;
+  other.label.resize(64 * 32);
+  other.valid.resize(64 * 32);
+  expect_rejected(gt::labels_pcd_bytes(other), "is not a labels file for a 64x48 scan");
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// Accuracy of a detection and its trajectory against synthetic ground truth (DESIGN.md,
-// "Metrics"): the paper's IoU lambda, plus waypoint errors against the true root line.
+// Accuracy of a detection and its trajectory against synthetic ground truth: the paper's IoU
+// lambda, plus waypoint errors against the true root line (docs/synthetic-scans.md,
+// "`groovetrace eval`").
 //
 // Frames: everything is compared in the scan's camera frame (metres). A trajectory written in
 // the robot base frame (`run --hand-eye ...`) cannot be compared; evaluate_files notes it.
@@ -87,7 +88,7 @@ struct RunOutput {
   std::vector<std::pair<std::string, double>> stage_ms;  ///< report.json stage timings
 };
 
-/// Reads annotated.pcd (binary or ascii PCD with a `groove` field), trajectory.csv (header
+/// Reads annotated.pcd (a PCD of any DATA kind with a `groove` field), trajectory.csv (header
 /// `idx,x_m,y_m,z_m,qx,qy,qz,qw,...`), and, when present, trajectory.json and report.json.
 /// Throws InputError when annotated.pcd is missing or malformed, or trajectory.csv malformed.
 RunOutput read_run_output(const std::string& result_dir);

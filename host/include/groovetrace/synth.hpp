@@ -3,7 +3,7 @@
 //
 // No public labelled scans of V-grooves exist, so accuracy claims rest on these: an analytic
 // workpiece on a welding table is ray cast through a pinhole camera, then a D415 sensor model
-// (DESIGN.md, "RealSense D415 facts") turns the ideal depth into what the camera returns.
+// (docs/design.md, the D415 sensor facts) turns the ideal depth into what the camera returns.
 //
 // Frames. The workpiece frame W: the table is the plane z = 0, z points up out of the table,
 // the seam runs along +x through the origin's vertical (x, y in the table plane). The camera
@@ -14,7 +14,6 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <groovetrace/cloud.hpp>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,7 +40,7 @@ std::vector<std::string> shape_names();
 
 /// Which sensor effects the D415 model applies (all only when SynthParams::noise is on).
 struct SensorEffects {
-  bool depth_noise = true;      ///< per-pixel disparity noise (DESIGN.md depth RMS formula)
+  bool depth_noise = true;      ///< per-pixel disparity noise (docs/design.md depth RMS formula)
   bool undulation = true;       ///< spatially correlated disparity error over 5-20 mm
   bool blur = true;             ///< stereo matching window averages disparity across creases
   bool flying_pixels = true;    ///< depths between foreground and background at jumps
@@ -64,7 +63,7 @@ SensorEffects parse_effects(const std::string& list);
 /// The comma-separated names of the effects that are on ("none" if no effect is on).
 std::string effects_string(const SensorEffects& effects);
 
-/// D415 constants of the sensor model. Defaults follow DESIGN.md; change them to model
+/// D415 constants of the sensor model. Defaults follow docs/design.md; change them to model
 /// another stereo camera.
 struct SensorModel {
   double hfov_deg = 65.0;              ///< horizontal field of view at every resolution (deg)
@@ -172,70 +171,6 @@ struct SynthScan {
 /// independent of the thread count. Throws UsageError for invalid params.
 SynthScan render(const SynthParams& params);
 
-// --- Building blocks (used by render; public so that tests can check each alone) ----------
-
-/// A surface point found by ray casting, workpiece frame.
-struct RayHit {
-  bool hit = false;
-  double t = 0.0;          ///< distance along the unit ray direction (m)
-  Eigen::Vector3d point;   ///< m
-  Eigen::Vector3d normal;  ///< unit, out of the solid
-  std::uint8_t label = 0;  ///< 1 = groove wall (or the table seen through the root gap)
-  bool table = false;      ///< the hit is on the table plane
-};
-
-/// The workpiece of SynthParams (shape and groove) on the table, in the workpiece frame.
-class SynthScene {
- public:
-  explicit SynthScene(const SynthParams& params);
-  ~SynthScene();
-  SynthScene(const SynthScene&) = delete;
-  SynthScene& operator=(const SynthScene&) = delete;
-
-  /// First surface along origin + t * direction (unit) with t < t_max, workpiece frame.
-  /// Sphere tracing on a 1-Lipschitz signed distance bound, then bisection to 1e-7 m.
-  RayHit intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                   double t_max) const;
-  /// True if a surface lies between `from` and `to` closer than `tolerance` (m) to `from`'s
-  /// side of `to` (i.e. `to` is hidden from `from`). Workpiece frame.
-  bool occluded(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double tolerance) const;
-  /// Signed distance bound of the workpiece (m): <= 0 inside, > 0 outside, 1-Lipschitz (not
-  /// the table).
-  double signed_distance(const Eigen::Vector3d& p) const;
-  /// The seams' root lines in the workpiece frame (in_view all 1).
-  std::vector<Seam> seams() const;
-  /// The point the camera looks at: the seam's centre on the top surface (m).
-  Eigen::Vector3d look_at() const;
-  const GrooveGeometry& groove() const;
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
-
-/// Camera pose for the params: looking straight down at scene.look_at() from `distance`
-/// with image x along the seam (+x of the workpiece), then pitched by tilt about the camera
-/// x axis and rolled about its optical axis, both about the look-at point.
-Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene);
-
-/// What an ideal sensor sees, per pixel in row-major order.
-struct IdealFrame {
-  std::vector<double> depth;           ///< camera-frame z of the hit (m); NaN: no surface
-  std::vector<float> cos_incidence;    ///< |cos| of the angle between ray and surface normal
-  std::vector<std::uint8_t> label;     ///< groove-wall label of the hit surface
-  std::vector<std::uint8_t> shadowed;  ///< 1: the right imager cannot see the hit point
-};
-
-/// Ray casts every pixel. Shadow rays only when noise and stereo_shadow are on.
-IdealFrame render_ideal(const SynthScene& scene, const CameraModel& camera,
-                        const Eigen::Isometry3d& T_workpiece_camera, const SynthParams& params);
-
-/// Applies the D415 model (the effects enabled in params) to an ideal frame and returns the
-/// organized camera-frame cloud (m, NaN = no return). With noise off the points are the exact
-/// hits.
-Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
-                      const SynthParams& params);
-
 // --- Files --------------------------------------------------------------------------------
 
 /// The three files of a synthetic scan: SCAN.pcd (binary organized XYZ), SCAN.truth.json
@@ -246,12 +181,6 @@ struct SynthFiles {
 };
 /// File names for a scan path, which must end in ".pcd" (UsageError otherwise).
 SynthFiles synth_files(const std::string& scan_path);
-
-/// SCAN.truth.json contents. `scan_name` and `labels_name` are recorded as written.
-std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
-                       const std::string& labels_name);
-/// SCAN.labels.pcd contents.
-std::string labels_pcd_bytes(const SynthTruth& truth);
 
 /// Writes SCAN.pcd and its truth files, each atomically. Returns their names.
 SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path);

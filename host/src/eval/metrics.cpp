@@ -1,4 +1,5 @@
-// Metrics of a detection and trajectory against synthetic ground truth (DESIGN.md "Metrics").
+// Metrics of a detection and trajectory against synthetic ground truth
+// (docs/synthetic-scans.md, "`groovetrace eval`").
 
 #include <algorithm>
 #include <cmath>
@@ -65,17 +66,11 @@ double percent(std::size_t num, std::size_t den) {
   return den == 0 ? kNaN : 100.0 * static_cast<double>(num) / static_cast<double>(den);
 }
 
-}  // namespace
-
-EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
-                     const std::vector<ToolPose>& poses, const EvalOptions& options) {
-  const std::size_t n = truth.label.size();
-  if (detected.size() != n || truth.valid.size() != n)
-    throw InputError("eval: the detection has " + std::to_string(detected.size()) +
-                     " points, the truth " + std::to_string(n));
-  EvalMetrics m;
-  m.points = n;
-  for (std::size_t i = 0; i < n; ++i) {
+// The detection against the labels, over the points where the scan has a return.
+void score_detection(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
+                     EvalMetrics& m) {
+  m.points = truth.label.size();
+  for (std::size_t i = 0; i < m.points; ++i) {
     if (!truth.valid[i]) continue;
     ++m.valid_points;
     const bool t = truth.label[i] != 0, d = detected[i] != 0;
@@ -86,64 +81,79 @@ EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& d
   m.iou_percent = percent(m.overlap_points, m.detected_points + m.truth_points - m.overlap_points);
   m.precision_percent = percent(m.overlap_points, m.detected_points);
   m.recall_percent = percent(m.overlap_points, m.truth_points);
+}
 
-  // Waypoints against the root lines.
+// One waypoint against the nearest root point, camera frame (m, deg).
+struct WaypointError {
+  double distance, lateral, depth;  // depth signed, + along the surface normal
+  double tool_deg, travel_deg;
+};
+
+WaypointError waypoint_error(const std::vector<Seam>& seams, const std::vector<ToolPose>& poses,
+                             std::size_t k) {
+  const Eigen::Vector3d& p = poses[k].position;
+  const RootPoint r = nearest_root(seams, p);
+  const Eigen::Vector3d e = p - r.point;
+  const Eigen::Vector3d across = r.tangent.cross(r.normal).normalized();
+  WaypointError w{r.distance, std::abs(e.dot(across)), e.dot(r.normal), 0, 0};
+  const Eigen::Matrix3d R = poses[k].orientation.normalized().toRotationMatrix();
+  w.tool_deg = angle_deg(R.col(2), -r.bisector);
+  // The direction of travel here, from the neighbouring waypoints.
+  const Eigen::Vector3d ahead =
+      poses[std::min(k + 1, poses.size() - 1)].position - poses[k == 0 ? 0 : k - 1].position;
+  Eigen::Vector3d tangent = r.tangent;
+  if (ahead.norm() > 0.0) {
+    if (tangent.dot(ahead) < 0) tangent = -tangent;
+    w.travel_deg = angle_deg(R.col(0), tangent);
+  } else {  // a single waypoint has no travel direction: either sense of the seam
+    w.travel_deg = std::min(angle_deg(R.col(0), tangent), angle_deg(R.col(0), -tangent));
+  }
+  return w;
+}
+
+// Waypoints against the root lines: means and maxima (NaN without waypoints or root line).
+void score_waypoints(const std::vector<Seam>& seams, const std::vector<ToolPose>& poses,
+                     EvalMetrics& m) {
   m.waypoints = poses.size();
   m.distance_mean = m.distance_max = m.lateral_mean = m.lateral_max = kNaN;
   m.depth_mean = m.depth_max = m.depth_bias = kNaN;
   m.tool_axis_mean_deg = m.tool_axis_max_deg = kNaN;
   m.travel_axis_mean_deg = m.travel_axis_max_deg = kNaN;
   bool any_root = false;
-  for (const Seam& s : truth.seams) any_root = any_root || s.root.size() >= 2;
-  if (!poses.empty() && any_root) {
-    double dist = 0, lat = 0, dep = 0, bias = 0, tool = 0, travel = 0;
-    m.distance_max = m.lateral_max = m.depth_max = 0;
-    m.tool_axis_max_deg = m.travel_axis_max_deg = 0;
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      const Eigen::Vector3d& p = poses[k].position;
-      const RootPoint r = nearest_root(truth.seams, p);
-      const Eigen::Vector3d e = p - r.point;
-      const Eigen::Vector3d across = r.tangent.cross(r.normal).normalized();
-      const double lateral = std::abs(e.dot(across)), depth = e.dot(r.normal);
-      dist += r.distance;
-      lat += lateral;
-      dep += std::abs(depth);
-      bias += depth;
-      m.distance_max = std::max(m.distance_max, r.distance);
-      m.lateral_max = std::max(m.lateral_max, lateral);
-      m.depth_max = std::max(m.depth_max, std::abs(depth));
-
-      const Eigen::Matrix3d R = poses[k].orientation.normalized().toRotationMatrix();
-      const double tool_err = angle_deg(R.col(2), -r.bisector);
-      // The direction of travel here, from the neighbouring waypoints.
-      const Eigen::Vector3d ahead =
-          poses[std::min(k + 1, poses.size() - 1)].position - poses[k == 0 ? 0 : k - 1].position;
-      Eigen::Vector3d tangent = r.tangent;
-      double travel_err = 0;
-      if (ahead.norm() > 0.0) {
-        if (tangent.dot(ahead) < 0) tangent = -tangent;
-        travel_err = angle_deg(R.col(0), tangent);
-      } else {  // a single waypoint has no travel direction: either sense of the seam
-        travel_err = std::min(angle_deg(R.col(0), tangent), angle_deg(R.col(0), -tangent));
-      }
-      tool += tool_err;
-      travel += travel_err;
-      m.tool_axis_max_deg = std::max(m.tool_axis_max_deg, tool_err);
-      m.travel_axis_max_deg = std::max(m.travel_axis_max_deg, travel_err);
-    }
-    const double count = static_cast<double>(poses.size());
-    m.distance_mean = dist / count;
-    m.lateral_mean = lat / count;
-    m.depth_mean = dep / count;
-    m.depth_bias = bias / count;
-    m.tool_axis_mean_deg = tool / count;
-    m.travel_axis_mean_deg = travel / count;
+  for (const Seam& s : seams) any_root = any_root || s.root.size() >= 2;
+  if (poses.empty() || !any_root) return;
+  double dist = 0, lat = 0, dep = 0, bias = 0, tool = 0, travel = 0;
+  m.distance_max = m.lateral_max = m.depth_max = 0;
+  m.tool_axis_max_deg = m.travel_axis_max_deg = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const WaypointError w = waypoint_error(seams, poses, k);
+    dist += w.distance;
+    lat += w.lateral;
+    dep += std::abs(w.depth);
+    bias += w.depth;
+    m.distance_max = std::max(m.distance_max, w.distance);
+    m.lateral_max = std::max(m.lateral_max, w.lateral);
+    m.depth_max = std::max(m.depth_max, std::abs(w.depth));
+    tool += w.tool_deg;
+    travel += w.travel_deg;
+    m.tool_axis_max_deg = std::max(m.tool_axis_max_deg, w.tool_deg);
+    m.travel_axis_max_deg = std::max(m.travel_axis_max_deg, w.travel_deg);
   }
+  const double count = static_cast<double>(poses.size());
+  m.distance_mean = dist / count;
+  m.lateral_mean = lat / count;
+  m.depth_mean = dep / count;
+  m.depth_bias = bias / count;
+  m.tool_axis_mean_deg = tool / count;
+  m.travel_axis_mean_deg = travel / count;
+}
 
-  // Coverage: the in-view root length whose points lie within the radius of the path.
+// Coverage: the in-view root length whose points lie within the radius of the path.
+void score_coverage(const std::vector<Seam>& seams, const std::vector<ToolPose>& poses,
+                    const EvalOptions& options, EvalMetrics& m) {
   m.coverage_radius = options.coverage_radius;
   double total = 0.0, covered = 0.0;
-  for (const Seam& s : truth.seams) {
+  for (const Seam& s : seams) {
     for (std::size_t k = 0; k + 1 < s.root.size(); ++k) {
       if (!s.in_view[k] || !s.in_view[k + 1]) continue;
       const Eigen::Vector3d a = s.root[k], ab = s.root[k + 1] - a;
@@ -160,6 +170,20 @@ EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& d
   }
   m.seam_length_in_view = total;
   m.coverage_percent = total > 0.0 ? 100.0 * covered / total : kNaN;
+}
+
+}  // namespace
+
+EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
+                     const std::vector<ToolPose>& poses, const EvalOptions& options) {
+  const std::size_t n = truth.label.size();
+  if (detected.size() != n || truth.valid.size() != n)
+    throw InputError("eval: the detection has " + std::to_string(detected.size()) +
+                     " points, the truth " + std::to_string(n));
+  EvalMetrics m;
+  score_detection(truth, detected, m);
+  score_waypoints(truth.seams, poses, m);
+  score_coverage(truth.seams, poses, options, m);
   m.runtime_ms = kNaN;
   m.points_per_second = kNaN;
   return m;

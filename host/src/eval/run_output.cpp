@@ -4,17 +4,17 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <groovetrace/error.hpp>
 #include <groovetrace/eval.hpp>
 #include <iterator>
 #include <limits>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "io/pcd.hpp"
 
 namespace groovetrace {
 namespace {
@@ -36,101 +36,21 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::istringstream in(s);
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
-
-// Reads one field of a PCD as "nonzero" flags, plus WIDTH and HEIGHT. Supports the DATA kinds
-// `binary` and `ascii`, which is what `run` writes (binary) and what people hand-edit (ascii).
-std::vector<std::uint8_t> read_pcd_flag_field(const std::string& path, const std::string& field,
-                                              std::uint32_t& width, std::uint32_t& height) {
-  std::string bytes;
-  if (!read_file(path, bytes)) throw InputError("eval: cannot read " + path);
-  std::map<std::string, std::vector<std::string>> header;
-  std::size_t pos = 0;
-  std::string data;
-  while (pos < bytes.size()) {
-    std::size_t end = bytes.find('\n', pos);
-    if (end == std::string::npos) end = bytes.size();
-    std::string line = bytes.substr(pos, end - pos);
-    pos = end + 1;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::vector<std::string> w = words(line);
-    if (w.empty() || w[0][0] == '#') continue;
-    header[w[0]] = std::vector<std::string>(w.begin() + 1, w.end());
-    if (w[0] == "DATA") {
-      data = w.size() > 1 ? w[1] : "";
-      break;
-    }
+// annotated.pcd's `groove` field as 0/1 flags, plus its WIDTH and HEIGHT, through the PCD
+// reader that checks scans (any DATA kind).
+std::vector<std::uint8_t> read_groove_flags(const std::string& path, std::uint32_t& width,
+                                            std::uint32_t& height) {
+  io::PcdTable table;
+  try {
+    table = io::read_pcd_fields(path, {"groove"});
+  } catch (const InputError& e) {
+    throw InputError(std::string("eval: ") + e.what());
   }
-  const auto& fields = header["FIELDS"];
-  const auto& sizes = header["SIZE"];
-  const auto& types = header["TYPE"];
-  std::vector<std::string> counts = header["COUNT"];
-  if (counts.empty()) counts.assign(fields.size(), "1");
-  if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() ||
-      counts.size() != fields.size() || header["WIDTH"].size() != 1 ||
-      header["HEIGHT"].size() != 1 || data.empty())
-    throw InputError("eval: " + path + " has a malformed PCD header");
-  width = static_cast<std::uint32_t>(std::strtoul(header["WIDTH"][0].c_str(), nullptr, 10));
-  height = static_cast<std::uint32_t>(std::strtoul(header["HEIGHT"][0].c_str(), nullptr, 10));
-  const std::size_t n = static_cast<std::size_t>(width) * height;
-
-  std::size_t record = 0, offset = 0, column = 0, columns = 0, size = 0;
-  char type = 0;
-  bool found = false;
-  for (std::size_t f = 0; f < fields.size(); ++f) {
-    const std::size_t sz = std::strtoul(sizes[f].c_str(), nullptr, 10);
-    const std::size_t ct = std::strtoul(counts[f].c_str(), nullptr, 10);
-    if (fields[f] == field) {
-      found = true;
-      offset = record;
-      column = columns;
-      size = sz;
-      type = types[f][0];
-    }
-    record += sz * ct;
-    columns += ct;
-  }
-  if (!found) throw InputError("eval: " + path + " has no '" + field + "' field");
-
-  std::vector<std::uint8_t> flags(n, 0);
-  if (data == "binary") {
-    if (bytes.size() < pos || bytes.size() - pos < n * record)
-      throw InputError("eval: " + path + " is truncated");
-    for (std::size_t i = 0; i < n; ++i) {
-      const char* p = bytes.data() + pos + i * record + offset;
-      bool nonzero = false;
-      if (type == 'F' && size == 4) {
-        float v;
-        std::memcpy(&v, p, 4);
-        nonzero = v != 0.0f;
-      } else if (type == 'F' && size == 8) {
-        double v;
-        std::memcpy(&v, p, 8);
-        nonzero = v != 0.0;
-      } else {  // integers: any nonzero byte
-        for (std::size_t b = 0; b < size; ++b) nonzero = nonzero || p[b] != 0;
-      }
-      flags[i] = nonzero ? 1 : 0;
-    }
-  } else if (data == "ascii") {
-    std::istringstream in(bytes.substr(pos));
-    std::string line;
-    std::size_t i = 0;
-    while (i < n && std::getline(in, line)) {
-      const std::vector<std::string> w = words(line);
-      if (w.empty()) continue;
-      if (w.size() != columns) throw InputError("eval: " + path + ": bad ascii point line");
-      flags[i++] = std::strtod(w[column].c_str(), nullptr) != 0.0 ? 1 : 0;
-    }
-    if (i != n) throw InputError("eval: " + path + " is truncated");
-  } else {
-    throw InputError("eval: " + path + ": DATA " + data + " is not supported (binary, ascii)");
-  }
+  width = table.width;
+  height = table.height;
+  const std::vector<float>& groove = *table.column("groove");
+  std::vector<std::uint8_t> flags(groove.size());
+  for (std::size_t i = 0; i < groove.size(); ++i) flags[i] = groove[i] != 0.0f ? 1 : 0;
   return flags;
 }
 
@@ -213,7 +133,7 @@ RunOutput read_run_output(const std::string& result_dir) {
   out.total_ms = kNaN;
   const std::string dir =
       result_dir.empty() || result_dir.back() == '/' ? result_dir : result_dir + "/";
-  out.groove = read_pcd_flag_field(dir + "annotated.pcd", "groove", out.width, out.height);
+  out.groove = read_groove_flags(dir + "annotated.pcd", out.width, out.height);
 
   std::string bytes;
   if (read_file(dir + "trajectory.csv", bytes)) {

@@ -1,5 +1,5 @@
-// Output files are complete or absent (DESIGN.md): write a temporary file beside the
-// target, make it durable, then rename it over the target, which POSIX makes atomic.
+// Output files are complete or absent (docs/design.md, CLI contract): write a temporary file
+// beside the target, make it durable, then rename it over the target, which POSIX makes atomic.
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -3,10 +3,11 @@
 
 #include <cmath>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <sstream>
 #include <string>
+
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {

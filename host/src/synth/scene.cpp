@@ -11,10 +11,11 @@
 #include <algorithm>
 #include <cmath>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {

@@ -11,12 +11,13 @@
 #include <algorithm>
 #include <cmath>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <limits>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {
@@ -123,31 +124,24 @@ CameraModel d415_camera(int width, int height, const SensorModel& sensor) {
   return c;
 }
 
-Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
-                      const SynthParams& params) {
-  const int W = camera.width, H = camera.height;
-  const std::size_t N = static_cast<std::size_t>(W) * H;
-  if (ideal.depth.size() != N) throw InternalError("simulate_sensor: frame size mismatch");
-  const SensorModel& m = params.sensor;
-  const SensorEffects eff = params.noise ? params.effects : SensorEffects::none();
+namespace {
 
-  Cloud cloud;
-  cloud.width = static_cast<std::uint32_t>(W);
-  cloud.height = static_cast<std::uint32_t>(H);
-  cloud.resize(N);
-  cloud.viewpoint.setZero();
-
-  // Disparity (px) times depth (m).
-  const double fb = camera.fx * m.baseline;
-
-  // Random numbers first, all of them, in a fixed order.
-  std::mt19937_64 master(params.seed);
-  const auto draw = [&master] { return static_cast<double>(master() >> 11) * 0x1.0p-53; };
+// Every random number of a scan, drawn first and in a fixed order from the seed.
+struct RandomDraws {
   struct Mode {
-    double kx, ky, phase;
+    double kx, ky, phase;  // wave vector (rad/m at the look-at distance), phase (rad)
   };
-  std::vector<Mode> modes(kUndulationModes);
-  for (Mode& mode : modes) {
+  std::vector<Mode> modes;                // the undulation's plane waves
+  std::vector<std::uint64_t> noise_seed;  // one per row of the noise field (with margin)
+  std::vector<std::uint64_t> row_seed;    // [stage * H + row]: flying pixels, dropouts
+};
+
+RandomDraws draw_random(const SensorModel& m, std::uint64_t seed, int noise_rows, int H) {
+  std::mt19937_64 master(seed);
+  const auto draw = [&master] { return static_cast<double>(master() >> 11) * 0x1.0p-53; };
+  RandomDraws r;
+  r.modes.resize(kUndulationModes);
+  for (RandomDraws::Mode& mode : r.modes) {
     const double lambda = m.undulation_min_wavelength +
                           draw() * (m.undulation_max_wavelength - m.undulation_min_wavelength);
     const double heading = 2.0 * kPi * draw();
@@ -155,170 +149,172 @@ Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
     mode.ky = 2.0 * kPi / lambda * std::sin(heading);
     mode.phase = 2.0 * kPi * draw();
   }
-  // The per-pixel noise field is drawn with a margin of the matching window on every side,
-  // so that every pixel's window is full.
-  const int r_window = std::max(1, static_cast<int>(std::lround(m.blur_radius_1280 * W / 1280.0)));
-  const int r_noise = m.correlate_noise ? r_window : 0;
-  const int NW = W + 2 * r_noise, NH = H + 2 * r_noise;
-  std::vector<std::uint64_t> noise_seed(NH);
-  for (auto& s : noise_seed) s = master();
-  std::vector<std::uint64_t> row_seed(static_cast<std::size_t>(kStages) * H);
-  for (auto& s : row_seed) s = master();
+  r.noise_seed.resize(noise_rows);
+  for (auto& s : r.noise_seed) s = master();
+  r.row_seed.resize(static_cast<std::size_t>(kStages) * H);
+  for (auto& s : r.row_seed) s = master();
+  return r;
+}
 
-  // Ideal disparity.
-  std::vector<double> d0(N, kNaN);
-  for (std::size_t i = 0; i < N; ++i)
-    if (std::isfinite(ideal.depth[i]) && ideal.depth[i] > 0.0) d0[i] = fb / ideal.depth[i];
-
-  // Stereo matching averages disparity over its window: creases round off, but a window
-  // never mixes the two sides of a depth jump (those become flying pixels below).
+// Stereo matching averages disparity over its window: creases round off, but a window
+// never mixes the two sides of a depth jump (those become flying pixels below).
+std::vector<double> blur_disparity(const std::vector<double>& d0, int W, int H, int r,
+                                   double jump_disparity) {
   std::vector<double> d1 = d0;
-  if (eff.blur) {
-    const int r = r_window;
-    const std::vector<double> w = binomial(r);
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
-      for (int u = 0; u < W; ++u) {
-        const std::size_t i = static_cast<std::size_t>(v) * W + u;
-        if (!std::isfinite(d0[i])) continue;
-        double sum = 0.0, weight = 0.0;
-        for (int dv = -r; dv <= r; ++dv) {
-          const int vv = v + dv;
-          if (vv < 0 || vv >= H) continue;
-          for (int du = -r; du <= r; ++du) {
-            const int uu = u + du;
-            if (uu < 0 || uu >= W) continue;
-            const double q = d0[static_cast<std::size_t>(vv) * W + uu];
-            if (!std::isfinite(q) || std::abs(q - d0[i]) > m.jump_disparity) continue;
-            const double wq = w[dv + r] * w[du + r];
-            sum += wq * q;
-            weight += wq;
-          }
-        }
-        d1[i] = sum / weight;
-      }
-    }
-  }
-
-  // Correlated undulation: plane waves over the image, with wavelengths in metres on a
-  // fronto-parallel plane at the look-at distance, i.e. tied to the image like the projector
-  // pattern and matching errors that cause it. Separable: sin(A + B) = sinA cosB + cosA sinB.
-  std::vector<double> col_sin, col_cos, row_sin, row_cos;
-  const double amplitude = m.undulation_disparity * std::sqrt(2.0 / kUndulationModes);
-  if (eff.undulation) {
-    // Layout [pixel column or row][mode], so the per-pixel sum runs over contiguous memory.
-    col_sin.resize(static_cast<std::size_t>(kUndulationModes) * W);
-    col_cos.resize(col_sin.size());
-    row_sin.resize(static_cast<std::size_t>(kUndulationModes) * H);
-    row_cos.resize(row_sin.size());
-    for (int k = 0; k < kUndulationModes; ++k) {
-      for (int u = 0; u < W; ++u) {
-        const double a =
-            modes[k].kx * (u - camera.cx) / camera.fx * params.distance + modes[k].phase;
-        col_sin[static_cast<std::size_t>(u) * kUndulationModes + k] = std::sin(a);
-        col_cos[static_cast<std::size_t>(u) * kUndulationModes + k] = std::cos(a);
-      }
-      for (int v = 0; v < H; ++v) {
-        const double b = modes[k].ky * (v - camera.cy) / camera.fy * params.distance;
-        row_sin[static_cast<std::size_t>(v) * kUndulationModes + k] = std::sin(b);
-        row_cos[static_cast<std::size_t>(v) * kUndulationModes + k] = std::cos(b);
-      }
-    }
-  }
-
-  // Per-pixel disparity noise. Neighbouring pixels share most of their matching window, so
-  // their errors are alike: white noise is smoothed with the window and scaled back to unit
-  // variance, which keeps the per-pixel RMS of the D415 formula.
-  std::vector<double> noise;
-  if (eff.depth_noise) {
-    std::vector<double> white(static_cast<std::size_t>(NW) * NH);
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < NH; ++v) {
-      Variates rng(noise_seed[v]);
-      for (int u = 0; u < NW; ++u) white[static_cast<std::size_t>(v) * NW + u] = rng.normal();
-    }
-    if (r_noise == 0) {
-      noise = std::move(white);
-    } else {
-      // Separable: rows, then columns; unit-sum weights a give variance (sum a^2)^2.
-      std::vector<double> a = binomial(r_noise);
-      double sum = 0.0, sum2 = 0.0;
-      for (double x : a) sum += x;
-      for (double& x : a) x /= sum;
-      for (double x : a) sum2 += x * x;
-      std::vector<double> rows(static_cast<std::size_t>(W) * NH);
-#pragma omp parallel for schedule(static)
-      for (int v = 0; v < NH; ++v)
-        for (int u = 0; u < W; ++u) {
-          double acc = 0.0;
-          for (int k = 0; k <= 2 * r_noise; ++k)
-            acc += a[k] * white[static_cast<std::size_t>(v) * NW + u + k];
-          rows[static_cast<std::size_t>(v) * W + u] = acc;
-        }
-      noise.assign(N, 0.0);
-#pragma omp parallel for schedule(static)
-      for (int v = 0; v < H; ++v)
-        for (int u = 0; u < W; ++u) {
-          double acc = 0.0;
-          for (int k = 0; k <= 2 * r_noise; ++k)
-            acc += a[k] * rows[static_cast<std::size_t>(v + k) * W + u];
-          noise[static_cast<std::size_t>(v) * W + u] = acc / sum2;
-        }
-    }
-  }
-
-  // Noise and undulation on the disparity.
-  std::vector<double> d2 = d1;
+  const std::vector<double> w = binomial(r);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * W + u;
-      if (!std::isfinite(d1[i])) continue;
-      if (eff.depth_noise) d2[i] += m.subpixel * noise[static_cast<std::size_t>(v) * W + u];
-      if (eff.undulation) {
-        const double* cs = &col_sin[static_cast<std::size_t>(u) * kUndulationModes];
-        const double* cc = &col_cos[static_cast<std::size_t>(u) * kUndulationModes];
-        const double* rs = &row_sin[static_cast<std::size_t>(v) * kUndulationModes];
-        const double* rc = &row_cos[static_cast<std::size_t>(v) * kUndulationModes];
-        double sum = 0.0;
-        for (int k = 0; k < kUndulationModes; ++k) sum += cs[k] * rc[k] + cc[k] * rs[k];
-        d2[i] += amplitude * sum;
-      }
-    }
-  }
-
-  // Flying pixels: at a depth jump, matching may lock onto a mix of both sides.
-  std::vector<double> d3 = d2;
-  if (eff.flying_pixels) {
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
-      Variates rng(row_seed[static_cast<std::size_t>(kFlyingStage) * H + v]);
-      for (int u = 0; u < W; ++u) {
-        const std::size_t i = static_cast<std::size_t>(v) * W + u;
-        const double chance = rng.uniform(), mix = rng.uniform();
-        if (!std::isfinite(d0[i])) continue;
-        double other = kNaN, jump = m.jump_disparity;
-        const int du[] = {-1, 1, 0, 0}, dv[] = {0, 0, -1, 1};
-        for (int k = 0; k < 4; ++k) {
-          const int uu = u + du[k], vv = v + dv[k];
-          if (uu < 0 || uu >= W || vv < 0 || vv >= H) continue;
+      if (!std::isfinite(d0[i])) continue;
+      double sum = 0.0, weight = 0.0;
+      for (int dv = -r; dv <= r; ++dv) {
+        const int vv = v + dv;
+        if (vv < 0 || vv >= H) continue;
+        for (int du = -r; du <= r; ++du) {
+          const int uu = u + du;
+          if (uu < 0 || uu >= W) continue;
           const double q = d0[static_cast<std::size_t>(vv) * W + uu];
-          if (std::isfinite(q) && std::abs(q - d0[i]) > jump) {
-            jump = std::abs(q - d0[i]);
-            other = q;
-          }
+          if (!std::isfinite(q) || std::abs(q - d0[i]) > jump_disparity) continue;
+          const double wq = w[dv + r] * w[du + r];
+          sum += wq * q;
+          weight += wq;
         }
-        if (std::isfinite(other) && chance < m.flying_probability)
-          d3[i] = d2[i] + mix * (other - d0[i]);
       }
+      d1[i] = sum / weight;
     }
   }
+  return d1;
+}
 
-  // Dropouts, then back to depth and points.
+// Correlated undulation: plane waves over the image, with wavelengths in metres on a
+// fronto-parallel plane at the look-at distance, i.e. tied to the image like the projector
+// pattern and matching errors that cause it. Separable: sin(A + B) = sinA cosB + cosA sinB,
+// so a pixel's value is a sum over the modes of its column's and its row's terms.
+struct Undulation {
+  // Layout [pixel column or row][mode], so the per-pixel sum runs over contiguous memory.
+  std::vector<double> col_sin, col_cos, row_sin, row_cos;
+  double amplitude = 0.0;
+
+  double at(int u, int v) const {
+    const double* cs = &col_sin[static_cast<std::size_t>(u) * kUndulationModes];
+    const double* cc = &col_cos[static_cast<std::size_t>(u) * kUndulationModes];
+    const double* rs = &row_sin[static_cast<std::size_t>(v) * kUndulationModes];
+    const double* rc = &row_cos[static_cast<std::size_t>(v) * kUndulationModes];
+    double sum = 0.0;
+    for (int k = 0; k < kUndulationModes; ++k) sum += cs[k] * rc[k] + cc[k] * rs[k];
+    return amplitude * sum;
+  }
+};
+
+Undulation undulation_table(const std::vector<RandomDraws::Mode>& modes, const CameraModel& camera,
+                            double distance, double disparity_std) {
+  const int W = camera.width, H = camera.height;
+  Undulation t;
+  t.amplitude = disparity_std * std::sqrt(2.0 / kUndulationModes);
+  t.col_sin.resize(static_cast<std::size_t>(kUndulationModes) * W);
+  t.col_cos.resize(t.col_sin.size());
+  t.row_sin.resize(static_cast<std::size_t>(kUndulationModes) * H);
+  t.row_cos.resize(t.row_sin.size());
+  for (int k = 0; k < kUndulationModes; ++k) {
+    for (int u = 0; u < W; ++u) {
+      const double a = modes[k].kx * (u - camera.cx) / camera.fx * distance + modes[k].phase;
+      t.col_sin[static_cast<std::size_t>(u) * kUndulationModes + k] = std::sin(a);
+      t.col_cos[static_cast<std::size_t>(u) * kUndulationModes + k] = std::cos(a);
+    }
+    for (int v = 0; v < H; ++v) {
+      const double b = modes[k].ky * (v - camera.cy) / camera.fy * distance;
+      t.row_sin[static_cast<std::size_t>(v) * kUndulationModes + k] = std::sin(b);
+      t.row_cos[static_cast<std::size_t>(v) * kUndulationModes + k] = std::cos(b);
+    }
+  }
+  return t;
+}
+
+// Per-pixel disparity noise of unit variance, W x H. Neighbouring pixels share most of their
+// matching window, so their errors are alike: white noise (drawn with a margin of r on every
+// side, so that every pixel's window is full) is smoothed with the window and scaled back to
+// unit variance, which keeps the per-pixel RMS of the D415 formula. r = 0: white noise.
+std::vector<double> noise_field(const std::vector<std::uint64_t>& row_seeds, int W, int H, int r) {
+  const int NW = W + 2 * r, NH = H + 2 * r;
+  std::vector<double> white(static_cast<std::size_t>(NW) * NH);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < NH; ++v) {
+    Variates rng(row_seeds[v]);
+    for (int u = 0; u < NW; ++u) white[static_cast<std::size_t>(v) * NW + u] = rng.normal();
+  }
+  if (r == 0) return white;
+  // Separable: rows, then columns; unit-sum weights a give variance (sum a^2)^2.
+  std::vector<double> a = binomial(r);
+  double sum = 0.0, sum2 = 0.0;
+  for (double x : a) sum += x;
+  for (double& x : a) x /= sum;
+  for (double x : a) sum2 += x * x;
+  std::vector<double> rows(static_cast<std::size_t>(W) * NH);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < NH; ++v)
+    for (int u = 0; u < W; ++u) {
+      double acc = 0.0;
+      for (int k = 0; k <= 2 * r; ++k)
+        acc += a[k] * white[static_cast<std::size_t>(v) * NW + u + k];
+      rows[static_cast<std::size_t>(v) * W + u] = acc;
+    }
+  std::vector<double> noise(static_cast<std::size_t>(W) * H, 0.0);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      double acc = 0.0;
+      for (int k = 0; k <= 2 * r; ++k) acc += a[k] * rows[static_cast<std::size_t>(v + k) * W + u];
+      noise[static_cast<std::size_t>(v) * W + u] = acc / sum2;
+    }
+  return noise;
+}
+
+// Flying pixels: at a depth jump, matching may lock onto a mix of both sides.
+std::vector<double> fly_pixels(const std::vector<double>& d0, const std::vector<double>& d2,
+                               const std::uint64_t* row_seeds, int W, int H, const SensorModel& m) {
+  std::vector<double> d3 = d2;
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < H; ++v) {
+    Variates rng(row_seeds[v]);
+    for (int u = 0; u < W; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * W + u;
+      const double chance = rng.uniform(), mix = rng.uniform();
+      if (!std::isfinite(d0[i])) continue;
+      double other = kNaN, jump = m.jump_disparity;
+      const int du[] = {-1, 1, 0, 0}, dv[] = {0, 0, -1, 1};
+      for (int k = 0; k < 4; ++k) {
+        const int uu = u + du[k], vv = v + dv[k];
+        if (uu < 0 || uu >= W || vv < 0 || vv >= H) continue;
+        const double q = d0[static_cast<std::size_t>(vv) * W + uu];
+        if (std::isfinite(q) && std::abs(q - d0[i]) > jump) {
+          jump = std::abs(q - d0[i]);
+          other = q;
+        }
+      }
+      if (std::isfinite(other) && chance < m.flying_probability)
+        d3[i] = d2[i] + mix * (other - d0[i]);
+    }
+  }
+  return d3;
+}
+
+// Dropouts, then back to depth and points: the organized cloud (NaN = no return).
+Cloud to_points(const IdealFrame& ideal, const std::vector<double>& d3, const CameraModel& camera,
+                const SynthParams& params, const SensorEffects& eff,
+                const std::uint64_t* row_seeds) {
+  const int W = camera.width, H = camera.height;
+  const SensorModel& m = params.sensor;
+  const double fb = camera.fx * m.baseline;
+  Cloud cloud;
+  cloud.width = static_cast<std::uint32_t>(W);
+  cloud.height = static_cast<std::uint32_t>(H);
+  cloud.resize(static_cast<std::size_t>(W) * H);
+  cloud.viewpoint.setZero();
   const double cos_start = std::cos(m.grazing_start_deg * kPi / 180.0);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < H; ++v) {
-    Variates rng(row_seed[static_cast<std::size_t>(kDropoutStage) * H + v]);
+    Variates rng(row_seeds[v]);
     for (int u = 0; u < W; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * W + u;
       const double graze_draw = rng.uniform(), drop_draw = rng.uniform();
@@ -352,6 +348,53 @@ Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
     }
   }
   return cloud;
+}
+
+}  // namespace
+
+Cloud simulate_sensor(const IdealFrame& ideal, const CameraModel& camera,
+                      const SynthParams& params) {
+  const int W = camera.width, H = camera.height;
+  const std::size_t N = static_cast<std::size_t>(W) * H;
+  if (ideal.depth.size() != N) throw InternalError("simulate_sensor: frame size mismatch");
+  const SensorModel& m = params.sensor;
+  const SensorEffects eff = params.noise ? params.effects : SensorEffects::none();
+
+  // The matching window's half-width at this resolution; the noise field shares it.
+  const int r_window = std::max(1, static_cast<int>(std::lround(m.blur_radius_1280 * W / 1280.0)));
+  const int r_noise = m.correlate_noise ? r_window : 0;
+  // Random numbers first, all of them, in a fixed order.
+  const RandomDraws random = draw_random(m, params.seed, H + 2 * r_noise, H);
+
+  // Ideal disparity (px): disparity times depth is fx * baseline.
+  const double fb = camera.fx * m.baseline;
+  std::vector<double> d0(N, kNaN);
+  for (std::size_t i = 0; i < N; ++i)
+    if (std::isfinite(ideal.depth[i]) && ideal.depth[i] > 0.0) d0[i] = fb / ideal.depth[i];
+  const std::vector<double> d1 =
+      eff.blur ? blur_disparity(d0, W, H, r_window, m.jump_disparity) : d0;
+
+  // Noise and undulation on the disparity.
+  std::vector<double> noise;
+  if (eff.depth_noise) noise = noise_field(random.noise_seed, W, H, r_noise);
+  Undulation undulation;
+  if (eff.undulation) {
+    undulation = undulation_table(random.modes, camera, params.distance, m.undulation_disparity);
+  }
+  std::vector<double> d2 = d1;
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < H; ++v) {
+    for (int u = 0; u < W; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * W + u;
+      if (!std::isfinite(d1[i])) continue;
+      if (eff.depth_noise) d2[i] += m.subpixel * noise[i];
+      if (eff.undulation) d2[i] += undulation.at(u, v);
+    }
+  }
+  const std::uint64_t* flying_seeds = &random.row_seed[static_cast<std::size_t>(kFlyingStage) * H];
+  const std::vector<double> d3 = eff.flying_pixels ? fly_pixels(d0, d2, flying_seeds, W, H, m) : d2;
+  return to_points(ideal, d3, camera, params, eff,
+                   &random.row_seed[static_cast<std::size_t>(kDropoutStage) * H]);
 }
 
 }  // namespace groovetrace

@@ -5,13 +5,13 @@
 #include <fstream>
 #include <groovetrace/cloud_io.hpp>
 #include <groovetrace/error.hpp>
-#include <groovetrace/synth.hpp>
 #include <iterator>
-#include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "io/pcd.hpp"
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {
@@ -116,6 +116,69 @@ std::string read_file(const std::string& path, const char* what) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+Seam seam_from_json(const json& s, const std::string& path) {
+  Seam seam;
+  seam.closed = s.at("closed").get<bool>();
+  for (const json& v : s.at("root")) seam.root.push_back(to_vec(v));
+  for (const json& v : s.at("normal")) seam.normal.push_back(to_vec(v));
+  for (const json& v : s.at("bisector")) seam.bisector.push_back(to_vec(v));
+  seam.in_view = s.at("in_view").get<std::vector<std::uint8_t>>();
+  if (seam.normal.size() != seam.root.size() || seam.bisector.size() != seam.root.size() ||
+      seam.in_view.size() != seam.root.size())
+    throw InputError("truth: " + path + ": seam arrays differ in length");
+  return seam;
+}
+
+// Everything of the truth but the labels. Throws json::exception for a missing or mistyped
+// key, UsageError for an unknown shape or effect.
+void truth_from_json(const json& j, const std::string& path, SynthTruth& truth) {
+  if (j.at("format").get<std::string>() != kTruthFormat)
+    throw InputError("truth: " + path + " is not a groovetrace truth file");
+  truth.params = params_from_json(j.at("params"));
+  const json& g = j.at("groove");
+  truth.groove.top_width = g.at("top_width_m").get<double>();
+  truth.groove.depth = g.at("depth_m").get<double>();
+  truth.groove.included_angle_deg = g.at("included_angle_deg").get<double>();
+  truth.groove.root_gap = g.at("root_gap_m").get<double>();
+  truth.groove.thickness = g.at("thickness_m").get<double>();
+  const json& c = j.at("camera");
+  truth.camera.width = c.at("width").get<int>();
+  truth.camera.height = c.at("height").get<int>();
+  truth.camera.fx = c.at("fx").get<double>();
+  truth.camera.fy = c.at("fy").get<double>();
+  truth.camera.cx = c.at("cx").get<double>();
+  truth.camera.cy = c.at("cy").get<double>();
+  const json& pose = j.at("T_workpiece_camera");
+  Eigen::Matrix4d T;
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 4; ++k) T(r, k) = pose.at(r).at(k).get<double>();
+  truth.T_workpiece_camera.matrix() = T;
+  for (const json& s : j.at("seams")) truth.seams.push_back(seam_from_json(s, path));
+}
+
+// SCAN.labels.pcd: `label` and `valid` per point of the camera's image.
+void read_labels(const std::string& path, SynthTruth& truth) {
+  io::PcdTable table;
+  try {
+    table = io::read_pcd_fields(path, {"label", "valid"});
+  } catch (const InputError& e) {
+    throw InputError(std::string("truth: ") + e.what());
+  }
+  if (table.width != static_cast<std::uint32_t>(truth.camera.width) ||
+      table.height != static_cast<std::uint32_t>(truth.camera.height))
+    throw InputError("truth: " + path + " is not a labels file for a " +
+                     std::to_string(truth.camera.width) + "x" +
+                     std::to_string(truth.camera.height) + " scan");
+  const std::vector<float>& label = *table.column("label");
+  const std::vector<float>& valid = *table.column("valid");
+  truth.label.resize(label.size());
+  truth.valid.resize(valid.size());
+  for (std::size_t i = 0; i < label.size(); ++i) {
+    truth.label[i] = label[i] != 0.0f ? 1 : 0;
+    truth.valid[i] = valid[i] != 0.0f ? 1 : 0;
+  }
+}
+
 }  // namespace
 
 SynthFiles synth_files(const std::string& scan_path) {
@@ -190,20 +253,11 @@ std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
 }
 
 std::string labels_pcd_bytes(const SynthTruth& truth) {
-  const std::size_t n = truth.label.size();
-  std::ostringstream h;
-  h << "# .PCD v0.7 - groovetrace synth labels: label (1 = groove wall), valid (1 = return)\n"
-    << "VERSION 0.7\nFIELDS label valid\nSIZE 1 1\nTYPE U U\nCOUNT 1 1\n"
-    << "WIDTH " << truth.camera.width << "\nHEIGHT " << truth.camera.height << "\n"
-    << "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA binary\n";
-  std::string bytes = h.str();
-  const std::size_t offset = bytes.size();
-  bytes.resize(offset + 2 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    bytes[offset + 2 * i] = static_cast<char>(truth.label[i]);
-    bytes[offset + 2 * i + 1] = static_cast<char>(truth.valid[i]);
-  }
-  return bytes;
+  return io::binary_pcd_bytes(
+      "groovetrace synth labels: label (1 = groove wall), valid (1 = return)",
+      static_cast<std::size_t>(truth.camera.width), static_cast<std::size_t>(truth.camera.height),
+      Eigen::Vector3f::Zero(),
+      {io::flag_column("label", &truth.label), io::flag_column("valid", &truth.valid)});
 }
 
 SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path) {
@@ -223,84 +277,24 @@ SynthTruth read_synth_truth(const std::string& scan_path) {
   } catch (const UsageError&) {
     throw InputError("truth: '" + scan_path + "' is not a .pcd scan path");
   }
-  SynthTruth truth;
   json j;
   try {
     j = json::parse(read_file(files.truth, "truth file"));
   } catch (const json::exception& e) {
     throw InputError("truth: " + files.truth + " is not valid JSON: " + e.what());
   }
+  SynthTruth truth;
   try {
-    if (j.at("format").get<std::string>() != kTruthFormat)
-      throw InputError("truth: " + files.truth + " is not a groovetrace truth file");
-    truth.params = params_from_json(j.at("params"));
-    const json& g = j.at("groove");
-    truth.groove.top_width = g.at("top_width_m").get<double>();
-    truth.groove.depth = g.at("depth_m").get<double>();
-    truth.groove.included_angle_deg = g.at("included_angle_deg").get<double>();
-    truth.groove.root_gap = g.at("root_gap_m").get<double>();
-    truth.groove.thickness = g.at("thickness_m").get<double>();
-    const json& c = j.at("camera");
-    truth.camera.width = c.at("width").get<int>();
-    truth.camera.height = c.at("height").get<int>();
-    truth.camera.fx = c.at("fx").get<double>();
-    truth.camera.fy = c.at("fy").get<double>();
-    truth.camera.cx = c.at("cx").get<double>();
-    truth.camera.cy = c.at("cy").get<double>();
-    const json& pose = j.at("T_workpiece_camera");
-    Eigen::Matrix4d T;
-    for (int r = 0; r < 4; ++r)
-      for (int k = 0; k < 4; ++k) T(r, k) = pose.at(r).at(k).get<double>();
-    truth.T_workpiece_camera.matrix() = T;
-    for (const json& s : j.at("seams")) {
-      Seam seam;
-      seam.closed = s.at("closed").get<bool>();
-      for (const json& v : s.at("root")) seam.root.push_back(to_vec(v));
-      for (const json& v : s.at("normal")) seam.normal.push_back(to_vec(v));
-      for (const json& v : s.at("bisector")) seam.bisector.push_back(to_vec(v));
-      seam.in_view = s.at("in_view").get<std::vector<std::uint8_t>>();
-      if (seam.normal.size() != seam.root.size() || seam.bisector.size() != seam.root.size() ||
-          seam.in_view.size() != seam.root.size())
-        throw InputError("truth: " + files.truth + ": seam arrays differ in length");
-      truth.seams.push_back(std::move(seam));
-    }
+    truth_from_json(j, files.truth, truth);
   } catch (const json::exception& e) {
     throw InputError("truth: " + files.truth + ": " + e.what());
   } catch (const UsageError& e) {
     throw InputError("truth: " + files.truth + ": " + e.what());
   }
-
-  // The labels file: a header of "KEY values" lines up to DATA, then 2 bytes per point.
   std::string labels_path = files.labels;
   if (j.contains("files") && j["files"].contains("labels"))
     labels_path = dir_name(files.truth) + j["files"]["labels"].get<std::string>();
-  const std::string bytes = read_file(labels_path, "labels file");
-  std::map<std::string, std::string> header;
-  std::size_t pos = 0;
-  while (pos < bytes.size()) {
-    const std::size_t end = bytes.find('\n', pos);
-    if (end == std::string::npos) break;
-    const std::string line = bytes.substr(pos, end - pos);
-    pos = end + 1;
-    if (line.empty() || line[0] == '#') continue;
-    const std::size_t space = line.find(' ');
-    header[line.substr(0, space)] = space == std::string::npos ? "" : line.substr(space + 1);
-    if (line.rfind("DATA", 0) == 0) break;
-  }
-  const std::size_t n = static_cast<std::size_t>(truth.camera.width) * truth.camera.height;
-  if (header["FIELDS"] != "label valid" || header["SIZE"] != "1 1" || header["TYPE"] != "U U" ||
-      header["DATA"] != "binary" || header["POINTS"] != std::to_string(n) ||
-      header["WIDTH"] != std::to_string(truth.camera.width))
-    throw InputError("truth: " + labels_path + " is not a labels file for a " +
-                     std::to_string(truth.camera.width) + "x" +
-                     std::to_string(truth.camera.height) + " scan");
-  if (bytes.size() - pos < 2 * n) throw InputError("truth: " + labels_path + " is truncated");
-  truth.label.resize(n);
-  truth.valid.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    truth.label[i] = static_cast<std::uint8_t>(bytes[pos + 2 * i]) ? 1 : 0;
-    truth.valid[i] = static_cast<std::uint8_t>(bytes[pos + 2 * i + 1]) ? 1 : 0;
-  }
+  read_labels(labels_path, truth);
   return truth;
 }
 

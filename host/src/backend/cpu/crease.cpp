@@ -7,8 +7,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include "core/eigen3.hpp"
 
+#include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
 
 namespace groovetrace {
@@ -41,6 +41,82 @@ double kth_smallest(const std::vector<double>& values, std::size_t k, std::vecto
   return bin[k - below];
 }
 
+// The ball of one point: its neighbours within the radius, relative to it (m).
+struct Ball {
+  std::vector<float> x, y, z, d2;  // d2: squared distance to the point
+  std::size_t size = 0;
+
+  // Room for every candidate of a cell, and one more for the branch-free compaction.
+  void reserve(std::size_t candidates) {
+    x.resize(candidates + 1);
+    y.resize(candidates + 1);
+    z.resize(candidates + 1);
+    d2.resize(candidates + 1);
+  }
+
+  // The block's candidates within sqrt(r2) of p, compacted without branches: every candidate
+  // is written, and the slot advances only for those inside.
+  void gather(const NeighborGrid::CellBlock& block, const Eigen::Vector3f& p, float r2) {
+    size = 0;
+    for (std::size_t k = 0; k < block.near.size(); ++k) {
+      const float ex = block.x[k] - p.x(), ey = block.y[k] - p.y(), ez = block.z[k] - p.z();
+      const float dd = ex * ex + ey * ey + ez * ez;
+      x[size] = ex;
+      y[size] = ey;
+      z[size] = ez;
+      d2[size] = dd;
+      size += dd <= r2 ? 1 : 0;
+    }
+  }
+};
+
+// The ball's plane fit in double: the unit normal, turned towards `to_viewpoint`.
+Eigen::Vector3d fit_normal(const Ball& ball, const Eigen::Vector3f& to_viewpoint) {
+  double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  for (std::size_t k = 0; k < ball.size; ++k) {
+    const double dx = ball.x[k], dy = ball.y[k], dz = ball.z[k];
+    mx += dx;
+    my += dy;
+    mz += dz;
+    xx += dx * dx;
+    xy += dx * dy;
+    xz += dx * dz;
+    yy += dy * dy;
+    yz += dy * dz;
+    zz += dz * dz;
+  }
+  const double count_d = static_cast<double>(ball.size);
+  const Eigen::Vector3d mean = Eigen::Vector3d(mx, my, mz) / count_d;
+  Eigen::Matrix3d s2;
+  s2 << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  Eigen::Vector3d normal = smallest_eigenvector(s2 / count_d - mean * mean.transpose());
+  if (normal.dot(to_viewpoint.cast<double>()) < 0) normal = -normal;
+  return normal;
+}
+
+// The envelope (a quantile of the heights along the normal) minus the point's own height
+// averaged over a small ball (its noise averaged out). `heights` and `bin` are scratch.
+float concavity(const Ball& ball, const Eigen::Vector3d& normal, const CreaseParams& params,
+                std::vector<double>& heights, std::vector<double>& bin) {
+  // In float, as the kernel compares: a neighbour at the rim of the own ball counts in both or
+  // in neither (a 3 mm ball of ~30 voxels moves its mean height by ~13 um per voxel).
+  const float own_r2 = params.own_radius * params.own_radius;
+  heights.resize(ball.size);
+  double own_sum = 0;
+  int own_count = 0;
+  for (std::size_t k = 0; k < ball.size; ++k) {
+    const double h = normal.x() * ball.x[k] + normal.y() * ball.y[k] + normal.z() * ball.z[k];
+    heights[k] = h;
+    const bool own = ball.d2[k] <= own_r2;
+    own_sum += own ? h : 0.0;
+    own_count += own ? 1 : 0;
+  }
+  const auto q = static_cast<std::size_t>(static_cast<double>(params.quantile) *
+                                          static_cast<double>(ball.size - 1));
+  const double envelope = kth_smallest(heights, q, bin);
+  return static_cast<float>(envelope - own_sum / std::max(own_count, 1));
+}
+
 }  // namespace
 
 CreaseMeasure crease_cpu(const Cloud& cloud, const CreaseParams& params) {
@@ -48,10 +124,7 @@ CreaseMeasure crease_cpu(const Cloud& cloud, const CreaseParams& params) {
   out.normals.resize(cloud.size());
   out.concavity.assign(cloud.size(), NAN);
   const NeighborGrid grid(cloud, params.radius);
-  const int min_count = std::max(params.min_neighbors, 3);
-  // In float, as the kernel compares: a neighbour at the rim of the own ball counts in both or
-  // in neither (a 3 mm ball of ~30 voxels moves its mean height by ~13 um per voxel).
-  const float own_r2 = params.own_radius * params.own_radius;
+  const std::size_t min_count = static_cast<std::size_t>(std::max(params.min_neighbors, 3));
   const std::int64_t cells = static_cast<std::int64_t>(grid.cell_count());
   const float r2 = params.radius * params.radius;
 #pragma omp parallel
@@ -59,68 +132,21 @@ CreaseMeasure crease_cpu(const Cloud& cloud, const CreaseParams& params) {
     // The candidates come per grid cell (all of a cell's points share them), so the distance
     // test is one tight loop over contiguous coordinates.
     NeighborGrid::CellBlock block;
-    // The ball of one point, relative to it (m), compacted without branches.
-    std::vector<float> bx, by, bz, bd2;
+    Ball ball;
     std::vector<double> heights, bin;
 #pragma omp for schedule(dynamic, 4)
     for (std::int64_t c = 0; c < cells; ++c) {
       grid.gather_cell(static_cast<std::size_t>(c), block);
-      const std::size_t m = block.near.size();
-      bx.resize(m + 1);
-      by.resize(m + 1);
-      bz.resize(m + 1);
-      bd2.resize(m + 1);
+      ball.reserve(block.near.size());
       for (const std::uint32_t v : block.members) {
         const Eigen::Vector3f p = cloud.point(v);
-        std::size_t found = 0;
-        for (std::size_t k = 0; k < m; ++k) {
-          const float ex = block.x[k] - p.x(), ey = block.y[k] - p.y(), ez = block.z[k] - p.z();
-          const float d2 = ex * ex + ey * ey + ez * ez;
-          bx[found] = ex;
-          by[found] = ey;
-          bz[found] = ez;
-          bd2[found] = d2;
-          found += d2 <= r2 ? 1 : 0;
-        }
-        if (found < static_cast<std::size_t>(min_count)) continue;
-        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-        for (std::size_t k = 0; k < found; ++k) {
-          const double dx = bx[k], dy = by[k], dz = bz[k];
-          mx += dx;
-          my += dy;
-          mz += dz;
-          xx += dx * dx;
-          xy += dx * dy;
-          xz += dx * dz;
-          yy += dy * dy;
-          yz += dy * dz;
-          zz += dz * dz;
-        }
-        const double count_d = static_cast<double>(found);
-        const Eigen::Vector3d mean = Eigen::Vector3d(mx, my, mz) / count_d;
-        Eigen::Matrix3d s2;
-        s2 << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-        Eigen::Vector3d normal = smallest_eigenvector(s2 / count_d - mean * mean.transpose());
-        if (normal.dot((cloud.viewpoint - p).cast<double>()) < 0) normal = -normal;
-        // The envelope (a quantile of the heights along the normal) minus the point's own
-        // height averaged over a small ball (its noise averaged out).
-        heights.resize(found);
-        double own_sum = 0;
-        int own_count = 0;
-        for (std::size_t k = 0; k < found; ++k) {
-          const double h = normal.x() * bx[k] + normal.y() * by[k] + normal.z() * bz[k];
-          heights[k] = h;
-          const bool own = bd2[k] <= own_r2;
-          own_sum += own ? h : 0.0;
-          own_count += own ? 1 : 0;
-        }
-        const auto q = static_cast<std::size_t>(static_cast<double>(params.quantile) *
-                                                static_cast<double>(found - 1));
-        const double envelope = kth_smallest(heights, q, bin);
+        ball.gather(block, p, r2);
+        if (ball.size < min_count) continue;
+        const Eigen::Vector3d normal = fit_normal(ball, cloud.viewpoint - p);
         out.normals.x[v] = static_cast<float>(normal.x());
         out.normals.y[v] = static_cast<float>(normal.y());
         out.normals.z[v] = static_cast<float>(normal.z());
-        out.concavity[v] = static_cast<float>(envelope - own_sum / std::max(own_count, 1));
+        out.concavity[v] = concavity(ball, normal, params, heights, bin);
       }
     }
   }

@@ -1,0 +1,127 @@
+// PLY files: the header's element counts checked against the file size, then PCL's decoder
+// (io/decode.hpp says why).
+
+#include <pcl/io/ply_io.h>
+
+#include <string>
+#include <string_view>
+
+#include "io/decode.hpp"
+#include "io/text.hpp"
+
+namespace groovetrace::io {
+namespace {
+
+std::uint64_t ply_type_size(std::string_view t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" ||
+      t == "float32") {
+    return 4;
+  }
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+// The least number of data bytes the header's elements take, summed as the header is read.
+struct PlyBodySize {
+  bool ascii = true;
+  std::uint64_t min_body = 0, element_min = 0, element_count = 0;
+
+  void close_element() {
+    min_body += checked_mul(element_count, element_min, "an element count");
+    if (min_body > kMaxDataBytes) reject("element counts are too large");
+    element_min = element_count = 0;
+  }
+};
+
+// One header line after the magic; returns true at end_header.
+bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bool& seen_format,
+                    PlyBodySize& body) {
+  const std::string_view key = tokens[0];
+  if (key == "comment" || key == "obj_info") return false;
+  if (key == "format") {
+    if (tokens.size() != 3 || (tokens[1] != "ascii" && tokens[1] != "binary_little_endian" &&
+                               tokens[1] != "binary_big_endian")) {
+      reject("malformed PLY header: unknown format line");
+    }
+    seen_format = true;
+    body.ascii = tokens[1] == "ascii";
+  } else if (key == "element") {
+    body.close_element();
+    if (tokens.size() != 3 || !parse_u64(tokens[2], body.element_count)) {
+      reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad element line");
+    }
+  } else if (key == "property") {
+    const bool list = tokens.size() == 5 && tokens[1] == "list";
+    const std::uint64_t size =
+        list ? ply_type_size(tokens[2]) : (tokens.size() == 3 ? ply_type_size(tokens[1]) : 0);
+    if (size == 0 || (list && ply_type_size(tokens[3]) == 0)) {
+      reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad property line");
+    }
+    body.element_min += body.ascii ? 2 : size;
+  } else if (key == "end_header") {
+    body.close_element();
+    return true;
+  } else {
+    reject("malformed PLY header: line " + std::to_string(line_no) + " ('" + shown(key, 20) +
+           "') is not a PLY header line");
+  }
+  return false;
+}
+
+// PCL's PLY reader sizes its buffers from the element counts before reading any data, so
+// the counts are checked against the file size first: each value takes at least its size
+// in binary, and at least a digit and a separator in ASCII (list properties at least their
+// length prefix).
+void check_ply_structure(const std::string& content) {
+  std::size_t pos = 0;
+  int line_no = 0;
+  bool seen_format = false, seen_end = false;
+  PlyBodySize body;
+  while (!seen_end && pos < content.size()) {
+    const auto tokens = split_ws(next_line(content, pos));
+    ++line_no;
+    if (line_no == 1) {
+      if (tokens.size() != 1 || tokens[0] != "ply") reject("malformed PLY header: no 'ply' magic");
+      continue;
+    }
+    if (tokens.empty()) continue;
+    seen_end = parse_ply_line(tokens, line_no, seen_format, body);
+  }
+  if (!seen_end) reject("malformed PLY header: no end_header line");
+  if (!seen_format) reject("malformed PLY header: no format line");
+  const std::uint64_t have = content.size() - pos;
+  // The last ASCII value may end the file without a separator.
+  const std::uint64_t need = body.ascii && body.min_body > 0 ? body.min_body - 1 : body.min_body;
+  if (have < need) {
+    reject("truncated PLY data: the header declares at least " + std::to_string(need) +
+           " bytes of data, the file has " + std::to_string(have));
+  }
+}
+
+}  // namespace
+
+Decoded decode_ply(const std::string& path, const std::string& content) {
+  Decoded out;
+  quietly([&] {
+    check_ply_structure(content);
+    pcl::PLYReader reader;
+    Eigen::Quaternionf orientation;
+    int version = 0;
+    // PLYReader takes only a path, so it reads the file again (from the page cache).
+    if (reader.read(path, out.blob, out.origin, orientation, version) < 0) {
+      reject("malformed or truncated PLY data (PCL cannot parse it)");
+    }
+    const pcl::PCLPointCloud2& blob = out.blob;
+    if (blob.data.size() != static_cast<std::size_t>(blob.width) * blob.height * blob.point_step) {
+      reject("malformed PLY data (PCL cannot decode it)");
+    }
+    // PCL 1.13 returns a zero origin even when the file has a camera element, but a later
+    // version may not; an unusable one is ignored rather than trusted.
+    if (!out.origin.head<3>().allFinite()) out.origin.setZero();
+  });
+  return out;
+}
+
+}  // namespace groovetrace::io
