@@ -1,4 +1,4 @@
-// The robust method's crease measure (host/src/crease_cpu.cpp is the reference): per point,
+// The robust method's crease measure (host/src/backend/cpu/crease.cpp is the reference): per point,
 // the plane normal of the points within r, and its concavity = the `quantile` of the
 // neighbours' heights along that normal (the upper envelope) minus the point's own height,
 // averaged over the neighbours within own_r. Unorganized clouds only (the robust method runs
