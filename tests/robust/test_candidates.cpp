@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
 
+#include "robust/stages.hpp"
 #include "support/robust_scenes.hpp"
 
 namespace groovetrace {

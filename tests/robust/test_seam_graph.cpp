@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
+
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -3,8 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
+
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 
+#include "robust/stages.hpp"
 #include "robust/stations.hpp"
 
 namespace groovetrace {

@@ -11,11 +11,11 @@
 #include <array>
 #include <climits>
 #include <cmath>
-#include "core/eigen3.hpp"
 #include <groovetrace/features.hpp>
-#include <groovetrace/robust.hpp>
 
+#include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

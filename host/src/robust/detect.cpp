@@ -5,12 +5,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include "core/eigen3.hpp"
-#include <groovetrace/robust.hpp>
 #include <numeric>
 
+#include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
 #include "robust/bins.hpp"
+#include "robust/stages.hpp"
 #include "robust/stations.hpp"
 
 namespace groovetrace {

@@ -10,9 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 
 #include "core/neighbor_grid.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -7,7 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
+
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

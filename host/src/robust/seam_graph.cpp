@@ -9,11 +9,11 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <numeric>
 #include <queue>
 
 #include "core/neighbor_grid.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -11,8 +11,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 
+#include "robust/stages.hpp"
 #include "robust/vmodel.hpp"
 
 namespace groovetrace {
