@@ -15,6 +15,7 @@
 
 #include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
+#include "core/stats.hpp"
 #include "robust/stages.hpp"
 
 namespace groovetrace {
@@ -108,12 +109,8 @@ std::pair<double, double> robust_location_scale(const std::vector<float>& values
     if (std::isfinite(x)) v.push_back(x);
   }
   if (v.empty()) return {NAN, NAN};
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  const double median = v[mid];
-  for (float& x : v) x = static_cast<float>(std::abs(x - median));
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return {median, 1.4826 * v[mid]};
+  const double median = upper_median(v);
+  return {median, mad_sigma(std::move(v), median)};
 }
 
 Cloud as_cloud(const std::vector<Eigen::Vector3f>& points) {

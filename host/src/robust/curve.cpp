@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/stats.hpp"
 #include "robust/stages.hpp"
 
 namespace groovetrace {
@@ -28,8 +29,7 @@ bool local_line(const std::vector<Eigen::Vector3d>& p, const std::vector<double>
   for (std::size_t k = 0; k < p.size(); ++k) {
     const double d = s[k] - s0;
     if (std::abs(d) >= h) continue;
-    const double t = 1 - std::pow(std::abs(d) / h, 3);
-    const double w = t * t * t;
+    const double w = tricube_weight(d, h);
     sw += w;
     ss += w * d;
     sss += w * d * d;
@@ -63,8 +63,7 @@ bool local_quad(const std::vector<Eigen::Vector3d>& p, const std::vector<double>
   for (std::size_t k = 0; k < p.size(); ++k) {
     const double d = s[k] - s0;
     if (std::abs(d) >= h) continue;
-    const double t = 1 - std::pow(std::abs(d) / h, 3);
-    const double w = t * t * t;
+    const double w = tricube_weight(d, h);
     const Eigen::Vector3d b(1, d / h, (d / h) * (d / h));
     A += w * b * b.transpose();
     B += w * b * p[k].transpose();
@@ -153,7 +152,7 @@ SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed,
     }
     d1.normalize();
     d2.normalize();
-    turn[k] = std::acos(std::clamp(d1.dot(d2), -1.0, 1.0)) * 57.29577951308232;
+    turn[k] = rad_to_deg(std::acos(std::clamp(d1.dot(d2), -1.0, 1.0)));
   }
   // A corner must hold at the legs' scale too: lines fitted over 2a on either side meet at
   // kCornerDeg or more. A zigzag of the node path (a stray node at 0.5 m and 640x480) turns
@@ -168,8 +167,7 @@ SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed,
       d1 -= d1.dot(nk) * nk;
       d2 -= d2.dot(nk) * nk;
     }
-    return std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)) *
-           57.29577951308232;
+    return rad_to_deg(std::acos(std::clamp(d1.normalized().dot(d2.normalized()), -1.0, 1.0)));
   };
   std::vector<double> cuts;
   for (std::size_t k = 0; k < n; ++k) {

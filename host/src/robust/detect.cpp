@@ -9,6 +9,7 @@
 
 #include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
+#include "core/stats.hpp"
 #include "robust/bins.hpp"
 #include "robust/stages.hpp"
 #include "robust/stations.hpp"
@@ -23,11 +24,6 @@ constexpr double kShapeWindow = 5.0;
 // still moved by up to 1.3 mm where few fits passed (a one-wall fit flipping to two walls);
 // at 1.0 the sweep's lateral and depth errors came out as good or better.
 constexpr double kPriorWeight = 1.0;
-
-double tukey(double r, double c) {
-  const double t = r / c;
-  return std::abs(t) >= 1 ? 0.0 : (1 - t * t) * (1 - t * t);
-}
 
 struct Context {
   const Cloud& cloud;
@@ -73,11 +69,9 @@ Eigen::Vector3d surface_normal(const Context& ctx, const Eigen::Vector3d& p,
     n = smallest_eigenvector(s2 / sw - mean * mean.transpose());
     if (iter == 2) break;
     for (std::size_t k = 0; k < pts.size(); ++k) dist[k] = std::abs(n.dot(pts[k] - mean));
-    std::vector<double> sorted = dist;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     // Floor: a tenth of a voxel, so that a noise-free plane does not reject its own rounding.
-    const double cut = 4.685 * std::max(1.4826 * sorted[sorted.size() / 2], 0.1 * ctx.params.cell);
-    for (std::size_t k = 0; k < pts.size(); ++k) w[k] = tukey(dist[k], cut);
+    const double cut = kTukeyC * std::max(kMadToSigma * upper_median(dist), 0.1 * ctx.params.cell);
+    for (std::size_t k = 0; k < pts.size(); ++k) w[k] = tukey_weight(dist[k], cut);
   }
   if (n.dot(fallback) < 0) n = -n;
   return n;
@@ -99,7 +93,7 @@ Eigen::Vector3d surface_tangent(const Context& ctx, const Eigen::Vector3d& p,
 constexpr double kGrazingDeg = 55.0;
 bool grazing(const Context& ctx, const Eigen::Vector3d& p, const Eigen::Vector3d& normal) {
   const Eigen::Vector3d ray = (ctx.cloud.viewpoint.cast<double>() - p).normalized();
-  return std::abs(ray.dot(normal.normalized())) < std::cos(kGrazingDeg * M_PI / 180);
+  return std::abs(ray.dot(normal.normalized())) < std::cos(deg_to_rad(kGrazingDeg));
 }
 
 // Fits the section at `origin` across the surface tangent; `normal` orients the profile.
@@ -160,11 +154,9 @@ Eigen::Matrix<double, N, 1> robust_local_linear(const std::vector<Eigen::Matrix<
   for (int iter = 0; iter < 2 && fit.allFinite(); ++iter) {
     std::vector<double> res(v.size());
     for (std::size_t q = 0; q < v.size(); ++q) res[q] = (v[q] - fit).norm();
-    std::vector<double> sorted = res;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double c = 4.685 * 1.4826 * sorted[sorted.size() / 2];
+    const double c = kTukeyC * kMadToSigma * upper_median(res);
     if (!(c > 0)) break;
-    for (std::size_t q = 0; q < v.size(); ++q) w[q] = w0[q] * tukey(res[q], c);
+    for (std::size_t q = 0; q < v.size(); ++q) w[q] = w0[q] * tukey_weight(res[q], c);
     fit = local_linear<N>(v, ds, w);
   }
   return fit;
@@ -197,10 +189,9 @@ void neighbours(const std::vector<GrooveSection>& raw, std::size_t k, const Seam
       d = d > 0 ? d - L : d + L;
     }
     if (std::abs(d) >= win) continue;
-    const double t = 1 - std::pow(std::abs(d) / win, 3);
     near.push_back(j);
     ds.push_back(d);
-    w.push_back(t * t * t);
+    w.push_back(tricube_weight(d, win));
   }
 }
 
@@ -261,10 +252,8 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
       // One Tukey reweighting: a fit that caught something else must not drag its neighbours.
       std::vector<double> res(near.size());
       for (std::size_t q = 0; q < near.size(); ++q) res[q] = (off[q] - o0).norm();
-      std::vector<double> sorted = res;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      const double c = std::max(4.685 * 1.4826 * sorted[sorted.size() / 2], 1e-4);
-      for (std::size_t q = 0; q < near.size(); ++q) w[q] *= tukey(res[q], c);
+      const double c = std::max(kTukeyC * kMadToSigma * upper_median(res), 1e-4);
+      for (std::size_t q = 0; q < near.size(); ++q) w[q] *= tukey_weight(res[q], c);
     }
     const Eigen::Vector2d o = mean_offset();
     s.root = curve.points[k] + o[0] * raw[k].across() + o[1] * raw[k].normal;
@@ -343,8 +332,7 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
     depths.push_back(s.depth);
   }
   if (widths.size() >= 3) {
-    std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-    std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+    const double width = upper_median(widths), depth = upper_median(depths);
     std::vector<std::uint32_t> scratch;
     for (std::size_t k = 0; k < m; ++k) {
       if (secs[k].ok) continue;
@@ -352,8 +340,7 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
       ctx.bins.within(ctx.cloud, curve.points[k], 1.3 * ctx.half_window + ctx.params.slab, scratch);
       GrooveSection g = fit_gap_section(ctx.cloud, scratch, curve.points[k],
                                         surface_tangent(ctx, curve.points[k], curve.tangents[k], n),
-                                        n, ctx.params.slab, ctx.half_window,
-                                        widths[widths.size() / 2], depths[depths.size() / 2]);
+                                        n, ctx.params.slab, ctx.half_window, width, depth);
       if (!g.inferred || !grazing(ctx, g.root, n) ||
           (g.root - curve.points[k]).norm() > 0.3 * ctx.params.scale) {
         continue;
@@ -390,9 +377,7 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
     depths.push_back(s.depth);
   }
   if (widths.empty()) return;
-  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  const double width = widths[widths.size() / 2], depth = depths[depths.size() / 2];
+  const double width = upper_median(widths), depth = upper_median(depths);
   for (int end = 0; end < 2; ++end) {
     if (end == 1) std::reverse(secs.begin(), secs.end());
     // Work at the back: drop trailing stations whose own fit failed.
@@ -454,7 +439,7 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
                                                        : 0.2) *
                                ctx.params.scale;
       const bool turned =
-          sec.inferred && sec.normal.dot(secs.back().normal) < std::cos(20.0 * M_PI / 180);
+          sec.inferred && sec.normal.dot(secs.back().normal) < std::cos(deg_to_rad(20.0));
       if ((sec.ok || sec.inferred) && (std::abs(off.dot(sec.across())) > across_tol ||
                                        std::abs(off.dot(sec.normal)) > depth_tol || turned)) {
         sec.ok = sec.inferred = false;
@@ -490,9 +475,7 @@ void reject_inconsistent(std::vector<GrooveSection>& secs) {
     depths.push_back(s.depth);
   }
   if (widths.size() < 5) return;
-  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  const double width = widths[widths.size() / 2], depth = depths[depths.size() / 2];
+  const double width = upper_median(widths), depth = upper_median(depths);
   for (auto& s : secs) {
     if (!s.ok) continue;
     if (s.width < 0.6 * width || s.width > 1.6 * width || s.depth < 0.6 * depth ||
@@ -513,8 +496,7 @@ void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
     if (s.ok && !s.one_wall) depths.push_back(s.depth);
   }
   if (depths.size() < 3) return;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  const double depth = depths[depths.size() / 2];
+  const double depth = upper_median(depths);
   for (auto& s : secs) {
     if (!s.ok || !s.one_wall) continue;
     const Eigen::Vector3d centre = 0.5 * (s.edge_left + s.edge_right);
@@ -540,18 +522,17 @@ double seam_asymmetry(const std::vector<GrooveSection>& secs) {
     asym.push_back(std::atan2(s.normal.cross(s.bisector).dot(s.tangent), s.normal.dot(s.bisector)));
   }
   if (asym.size() < 3) return NAN;
-  std::nth_element(asym.begin(), asym.begin() + asym.size() / 2, asym.end());
-  return asym[asym.size() / 2];
+  return upper_median(asym);
 }
 
 bool symmetric_seam(const std::vector<GrooveSection>& secs) {
-  return std::abs(seam_asymmetry(secs)) < kSymmetricDeg * M_PI / 180;  // false for NaN
+  return std::abs(seam_asymmetry(secs)) < deg_to_rad(kSymmetricDeg);  // false for NaN
 }
 
 void align_bisectors(std::vector<GrooveSection>& secs) {
   double turn = seam_asymmetry(secs);
   if (std::isnan(turn)) return;
-  if (std::abs(turn) < kSymmetricDeg * M_PI / 180) turn = 0.0;
+  if (std::abs(turn) < deg_to_rad(kSymmetricDeg)) turn = 0.0;
   for (auto& s : secs) {
     if (!s.ok && !s.inferred) continue;
     s.bisector = Eigen::AngleAxisd(turn, s.tangent.normalized()) * s.normal;
@@ -589,8 +570,7 @@ void trim_ends(SeamCandidate& seam, double link) {
     if (s.ok) widths.push_back(s.width);
   }
   if (widths.size() < 3) return;
-  std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  const double width = widths[widths.size() / 2];
+  const double width = upper_median(widths);
   auto bad = [&](const GrooveSection& s) {
     if (s.inferred) return false;
     return !s.ok || s.width > 1.4 * width || s.width < 0.6 * width;
@@ -720,8 +700,7 @@ bool same_groove(const SeamCandidate& a, const SeamCandidate& b) {
       width = 0;
       return;
     }
-    std::nth_element(w.begin(), w.begin() + w.size() / 2, w.end());
-    width = w[w.size() / 2];
+    width = upper_median(w);
   };
   double oka, wa, okb, wb;
   stats(a, oka, wa);

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/stats.hpp"
 #include "robust/stages.hpp"
 #include "robust/vmodel.hpp"
 
@@ -30,15 +31,6 @@ using robust_detail::top_at;
 using robust_detail::Vec6;
 using robust_detail::VModel;
 
-constexpr double kRadToDeg = 57.295779513082320876;
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
-
 // Robust sigma of residuals: the rms of the smallest 80% of |r|, scaled to a Gaussian's sigma
 // (0.6616 sigma for a Gaussian). Unlike the MAD it does not collapse to zero on depths
 // quantized to 1 mm, where most of a flat's points share one value.
@@ -51,12 +43,6 @@ double robust_sigma(const std::vector<double>& r) {
   double ss = 0;
   for (std::size_t k = 0; k < keep; ++k) ss += a[k];
   return std::sqrt(ss / keep) / 0.6616;
-}
-
-double tukey(double r, double c) {
-  if (!(c > 0)) return 1.0;
-  const double t = r / c;
-  return std::abs(t) >= 1 ? 0.0 : (1 - t * t) * (1 - t * t);
 }
 
 }  // namespace
@@ -87,7 +73,8 @@ std::pair<Eigen::Vector3d, double> robust_detail::fit_poly(const std::vector<Eig
       r[k] = pts[k].y() - (q[0] + q[1] * u + q[2] * u * u);
     }
     sigma = robust_sigma(r);
-    for (std::size_t k = 0; k < r.size(); ++k) w[k] = tukey(r[k], 4.685 * std::max(sigma, 1e-7));
+    for (std::size_t k = 0; k < r.size(); ++k)
+      w[k] = tukey_weight_or_one(r[k], kTukeyC * std::max(sigma, 1e-7));
   }
   return {q, sigma};
 }
@@ -98,7 +85,7 @@ namespace {
 // tangent `inward` (unit, along the top towards the groove). Positive: into the material.
 double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool left) {
   const double cross = inward.x() * wall.y() - inward.y() * wall.x();
-  return std::atan2(left ? -cross : cross, inward.dot(wall)) * kRadToDeg;
+  return rad_to_deg(std::atan2(left ? -cross : cross, inward.dot(wall)));
 }
 
 bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
@@ -167,7 +154,7 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
     M(kRightU, 2) += 1;
     return M;
   };
-  double c = 4.685 * scale;
+  double c = kTukeyC * scale;
   auto cost = [&](const VModel& v) {
     double sum = 0;
     for (const auto& p : pts) {
@@ -182,7 +169,7 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
   // Graduated: a wide Tukey window first, so that a start a few millimetres off still sees
   // the walls, then halving down to the noise.
   for (double stage = std::max(coarse, scale);; stage = std::max(scale, 0.5 * stage)) {
-    c = 4.685 * stage;
+    c = kTukeyC * stage;
     double f = cost(unpack(x));
     for (int iter = 0; iter < 30; ++iter) {
       const VModel cur = unpack(x);
@@ -194,7 +181,7 @@ bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, 
         Vec6 J;
         const double r = nearest_piece(pts[k], cur, &J).second;
         J = (M.transpose() * J).eval();
-        const double w = tukey(r, c);
+        const double w = tukey_weight_or_one(r, c);
         if (w <= 0) continue;
         JtJ += w * J * J.transpose();
         Jtr += w * J * r;
@@ -276,7 +263,8 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> fit_line(const std::vector<Eigen::Ve
     c = mean;
     d = eig.eigenvectors().col(1).normalized();
     const Eigen::Vector2d nrm(-d.y(), d.x());
-    for (std::size_t k = 0; k < pts.size(); ++k) w[k] = tukey((pts[k] - c).dot(nrm), 4.685 * scale);
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      w[k] = tukey_weight_or_one((pts[k] - c).dot(nrm), kTukeyC * scale);
   }
   return {c, d};
 }
@@ -294,7 +282,7 @@ PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m,
   double ss = 0;
   int nw = 0, outer = 0, outer_bad = 0;
   std::vector<double> top_r;
-  const double c = 4.685 * scale;
+  const double c = kTukeyC * scale;
   for (const auto& p : pts) {
     const auto [piece, r] = nearest_piece(p, m);
     const bool is_top = piece == 0 || piece == 3;
@@ -403,7 +391,7 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   for (std::size_t k = 0; k < groove.size(); ++k) {
     if (depths[k] >= 0.8 * d90) deep_u.push_back(groove[k].x());
   }
-  const double u0 = median_of(deep_u);
+  const double u0 = upper_median(deep_u);
   VModel m;
   m.q = q;
   m.root = Eigen::Vector2d(u0, top_at(q, u0) - d90);
@@ -469,7 +457,7 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
     const Eigen::Vector2d tr = Eigen::Vector2d(1, v.q[1] + 2 * v.q[2] * er.x()).normalized();
     o.wall_left_deg = dip_deg(tl, to_root_l, true);
     o.wall_right_deg = dip_deg(-tr, to_root_r, false);
-    o.opening_deg = std::acos(std::clamp(to_root_l.dot(to_root_r), -1.0, 1.0)) * kRadToDeg;
+    o.opening_deg = rad_to_deg(std::acos(std::clamp(to_root_l.dot(to_root_r), -1.0, 1.0)));
     o.bisector = (-to_root_l - to_root_r).normalized();
     const int wall_min = one_wall ? 0 : min_wall;
     if (!o.root.allFinite() || !el.allFinite() || !er.allFinite()) {
@@ -516,7 +504,7 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   for (const auto& p : pts) {
     if (near_vertex(p, m, vertex_zone)) continue;
     const auto [piece, r] = nearest_piece(p, m);
-    if (piece == (left_missing ? 2 : 1) && std::abs(r) < 4.685 * scale) wall_pts.push_back(p);
+    if (piece == (left_missing ? 2 : 1) && std::abs(r) < kTukeyC * scale) wall_pts.push_back(p);
   }
   if (wall_pts.size() < static_cast<std::size_t>(2 * min_wall)) return out;
   const auto [wc, wd] = fit_line(wall_pts, scale);
@@ -539,7 +527,7 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   std::sort(tops.begin(), tops.end());
   std::vector<double> gaps;
   for (std::size_t k = 1; k < tops.size(); ++k) gaps.push_back(tops[k] - tops[k - 1]);
-  const double spacing = median_of(gaps);
+  const double spacing = upper_median(gaps);
   std::size_t last = 0;
   while (last + 1 < tops.size() && tops[last + 1] - tops[last] <= std::max(3 * spacing, 0.1 * W)) {
     ++last;
