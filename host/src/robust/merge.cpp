@@ -70,6 +70,80 @@ bool same_groove(const SeamCandidate& a, const SeamCandidate& b) {
          std::abs(wa - wb) <= 0.3 * std::max(wa, wb);
 }
 
+// The indices of b's sections away from a (none of a's roots within half a `link`, m), when
+// they are one run of at least two; empty otherwise.
+std::vector<std::size_t> rest_of(const SeamCandidate& a, const SeamCandidate& b, double link) {
+  std::vector<std::size_t> rest;
+  for (std::size_t k = 0; k < b.sections.size(); ++k) {
+    bool overlaps = false;
+    for (const auto& s : a.sections) {
+      if ((s.root - b.sections[k].root).norm() < 0.5 * link) {
+        overlaps = true;
+        break;
+      }
+    }
+    if (!overlaps) rest.push_back(k);
+  }
+  if (rest.size() < 2 || rest.back() - rest.front() + 1 != rest.size()) return {};
+  return rest;
+}
+
+// The facing pair of ends, a's `end_a` and the run's `end_b` (0 first, 1 last), and the
+// distance between them (m).
+double facing_ends(const SeamCandidate& a, const SeamCandidate& b,
+                   const std::vector<std::size_t>& rest, int& end_a, int& end_b) {
+  double best = INFINITY;
+  for (int ea = 0; ea < 2; ++ea) {
+    for (int eb = 0; eb < 2; ++eb) {
+      const Eigen::Vector3d pa = ea == 0 ? a.sections.front().root : a.sections.back().root;
+      const Eigen::Vector3d pb =
+          (eb == 0 ? b.sections[rest.front()] : b.sections[rest.back()]).root;
+      const double d = (pa - pb).norm();
+      if (d < best) {
+        best = d;
+        end_a = ea;
+        end_b = eb;
+      }
+    }
+  }
+  return best;
+}
+
+// a and b's run joined end to end at the facing ends, as roots (m) and top normals.
+void joined_nodes(const SeamCandidate& a, const SeamCandidate& b,
+                  const std::vector<std::size_t>& rest, int end_a, int end_b,
+                  std::vector<Eigen::Vector3d>& ordered, std::vector<Eigen::Vector3d>& normals) {
+  for (std::size_t q = 0; q < a.sections.size(); ++q) {
+    const auto& s = a.sections[end_a == 1 ? q : a.sections.size() - 1 - q];
+    ordered.push_back(s.root);
+    normals.push_back(s.normal);
+  }
+  for (std::size_t q = 0; q < rest.size(); ++q) {
+    const auto& s = b.sections[end_b == 0 ? rest[q] : rest[rest.size() - 1 - q]];
+    ordered.push_back(s.root);
+    normals.push_back(s.normal);
+  }
+}
+
+// a and b traced again as one seam (`joined`) when they are stretches of one: b's run away
+// from a touches an end of a (within `link`, m) or, untrimmed, continues it across a gap of up
+// to 3 links as the same groove. False otherwise or when the joined trace fails.
+bool join_seams(const Context& ctx, const SeamCandidate& a, const SeamCandidate& b, double link,
+                SeamCandidate& joined) {
+  if (a.sections.size() < 2 || b.sections.size() < 2) return false;
+  const std::vector<std::size_t> rest = rest_of(a, b, link);
+  if (rest.empty()) return false;
+  const bool trimmed = rest.size() < b.sections.size();
+  int end_a = 0, end_b = 0;
+  bool join = facing_ends(a, b, rest, end_a, end_b) <= link;
+  if (!join && !trimmed) join = collinear_gap(a, b) <= 3 * link && same_groove(a, b);
+  if (!join) return false;
+  std::vector<Eigen::Vector3d> ordered, normals;
+  joined_nodes(a, b, rest, end_a, end_b, ordered, normals);
+  joined = trace_seam(ctx, ordered, normals, false);
+  return joined.sections.size() >= 2;
+}
+
 }  // namespace
 
 // Seams traced from separate node paths can be one: the tracking of one runs into the other,
@@ -84,55 +158,8 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
     for (std::size_t i = 0; i < seams.size() && !merged; ++i) {
       for (std::size_t j = 0; j < seams.size() && !merged; ++j) {
         if (i == j || seams[i].closed || seams[j].closed) continue;
-        const SeamCandidate& a = seams[i];
-        const SeamCandidate& b = seams[j];
-        if (a.sections.size() < 2 || b.sections.size() < 2) continue;
-        // b's sections away from a, as one run.
-        std::vector<std::size_t> rest;
-        for (std::size_t k = 0; k < b.sections.size(); ++k) {
-          bool overlaps = false;
-          for (const auto& s : a.sections) {
-            if ((s.root - b.sections[k].root).norm() < 0.5 * link) {
-              overlaps = true;
-              break;
-            }
-          }
-          if (!overlaps) rest.push_back(k);
-        }
-        if (rest.size() < 2 || rest.back() - rest.front() + 1 != rest.size()) continue;
-        const bool trimmed = rest.size() < b.sections.size();
-        // The facing pair of ends, and the join's reach.
-        double best = INFINITY;
-        int best_ea = 0, best_eb = 0;
-        for (int ea = 0; ea < 2; ++ea) {
-          for (int eb = 0; eb < 2; ++eb) {
-            const Eigen::Vector3d pa = ea == 0 ? a.sections.front().root : a.sections.back().root;
-            const Eigen::Vector3d pb =
-                (eb == 0 ? b.sections[rest.front()] : b.sections[rest.back()]).root;
-            const double d = (pa - pb).norm();
-            if (d < best) {
-              best = d;
-              best_ea = ea;
-              best_eb = eb;
-            }
-          }
-        }
-        bool join = best <= link;
-        if (!join && !trimmed) join = collinear_gap(a, b) <= 3 * link && same_groove(a, b);
-        if (!join) continue;
-        std::vector<Eigen::Vector3d> ordered, normals;
-        for (std::size_t q = 0; q < a.sections.size(); ++q) {
-          const auto& s = a.sections[best_ea == 1 ? q : a.sections.size() - 1 - q];
-          ordered.push_back(s.root);
-          normals.push_back(s.normal);
-        }
-        for (std::size_t q = 0; q < rest.size(); ++q) {
-          const auto& s = b.sections[best_eb == 0 ? rest[q] : rest[rest.size() - 1 - q]];
-          ordered.push_back(s.root);
-          normals.push_back(s.normal);
-        }
-        SeamCandidate joined = trace_seam(ctx, ordered, normals, false);
-        if (joined.sections.size() < 2) continue;
+        SeamCandidate joined;
+        if (!join_seams(ctx, seams[i], seams[j], link, joined)) continue;
         const std::size_t hi = std::max(i, j), lo = std::min(i, j);
         seams.erase(seams.begin() + static_cast<std::ptrdiff_t>(hi));
         seams.erase(seams.begin() + static_cast<std::ptrdiff_t>(lo));
