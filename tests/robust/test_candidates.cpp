@@ -1,4 +1,4 @@
-// Concave-crease candidates (robust_candidates.cpp): a groove's root is concave, a convex edge
+// Concave-crease candidates (robust/candidates.cpp): a groove's root is concave, a convex edge
 // is not, and the threshold follows the scan's own noise.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-// Seams as ordered curves (robust_seam_graph.cpp): order along the seam's own curve, rings
-// closed, L-corners kept, parallel seams apart.
+// Seams as ordered curves (robust/node_order.cpp, robust/curve.cpp): order along the seam's own
+// curve, rings closed, L-corners kept, parallel seams apart.
 #include <gtest/gtest.h>
 
 #include <algorithm>

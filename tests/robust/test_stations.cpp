@@ -1,4 +1,4 @@
-// Stations along a seam anchored to the frame (robust_stations.cpp): where a seam's curve
+// Stations along a seam anchored to the frame (robust/stations.cpp): where a seam's curve
 // starts must not move the stations along it.
 #include <gtest/gtest.h>
 

@@ -88,8 +88,9 @@ struct SeamCandidate {
 
 /// Torch poses along a seam: positions on the smoothed root line every `step` (or in
 /// `slices` equal parts), tool z = -wall bisector, tool x along the seam; rotation vectors
-/// continuous. A closed seam ends where it started. Travel runs so that the end lies at
-/// larger x of the cloud's frame than the start (ties: y).
+/// continuous. An open seam ends at larger x of the cloud's frame than it starts (ties: y, then
+/// z); a closed seam starts at its smallest x, runs counter-clockwise about its mean top
+/// normal and ends where it started.
 Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
 /// Everything the robust method decided.

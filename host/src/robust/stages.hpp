@@ -74,10 +74,12 @@ struct VProfile {
 };
 
 /// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
-/// quadratic (so pipes work), the points clearly below it as two walls (robust orthogonal line
-/// fits, iterated with their intersection), edges where walls meet the top. `ok` only when the
-/// profile is a V: both walls inclined into the material, both top sides present, depth above
-/// the noise. Rims and root, which sensors round off, do not enter the wall fits.
+/// quadratic (so pipes work), then the whole V - root, both edges, the top's offset and slope -
+/// by a Tukey-weighted Gauss-Newton fit to the points' orthogonal distances, started from the
+/// run of points clearly below the top; edges are where the walls meet the top. `ok` only when
+/// the profile is a V: both walls inclined into the material, both top sides present, depth
+/// above the noise. Rims and root, which sensors round off, do not enter the fit. With one wall
+/// seen and the other at a grazing angle, the V is taken symmetric (VProfile::one_wall).
 /// `symmetric`: the V is known to be symmetric (the seam's walls dip alike): after the free
 /// fit, the walls are refitted with equal dips about the top normal through the root, so a
 /// poorly sampled wall (a grazing view puts two image rows on it) takes its slope from the
@@ -126,7 +128,8 @@ std::vector<NodePath> order_nodes(const std::vector<Eigen::Vector3d>& points,
 /// keeping sharp corners as corners, and resamples it every `spacing` (m). A corner is a turn
 /// of over 45 degrees between the chords 3 half_window before and after a point, measured in
 /// the surface (the plane normal to `normals`, one per point, when given: depth noise of the
-/// roots must not look like a corner), kept at its maximum within 6 half_window.
+/// roots must not look like a corner), kept at its maximum within 6 half_window, and held by
+/// the lines fitted over 6 half_window on either side.
 SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed, double half_window,
                        double spacing, const std::vector<Eigen::Vector3d>& normals = {});
 

@@ -1,4 +1,4 @@
-// Stations along a seam anchored to the cloud's frame (see robust_stations.hpp).
+// Stations along a seam anchored to the cloud's frame (see stations.hpp).
 
 #include "robust/stations.hpp"
 

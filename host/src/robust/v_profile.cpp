@@ -2,11 +2,12 @@
 //
 // The profile is (u across, v height): top surface, two walls. The top is fitted first, from
 // the outer half of the window where no groove lies, as a robust quadratic (a pipe's crown
-// bends 2-4 mm over a 20 mm window). Points clearly below it are the groove; each side of the
-// deepest point is a wall, fitted as an orthogonal line (walls are steep, so residuals in v
-// alone would weigh them wrongly). The rims and the root are left out of the wall fits:
-// stereo matching rounds both off, and the root gap is not a wall. Root = the walls'
-// intersection, edges = walls meet top.
+// bends 2-4 mm over a 20 mm window). Points clearly below it are the groove; from their run a
+// first V (root at the deepest points, edges at the run's ends) is refined as a whole - root,
+// both edges, the top's offset and slope - on the points' orthogonal distances (walls are
+// steep, so residuals in v alone would weigh them wrongly). The rims and the root are left out
+// of the fit: stereo matching rounds both off, and the root gap is not a wall. Root = the
+// walls' intersection, edges = walls meet top.
 
 #include <Eigen/Dense>
 #include <algorithm>
