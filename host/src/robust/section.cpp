@@ -77,6 +77,47 @@ std::vector<Eigen::Vector2d> thinned(const Profile& pr) {
   return out;
 }
 
+// Of the gaps between neighbouring values of the sorted `u` (m) that are 0.6-1.6 times `width`
+// (m) wide, the one whose centre is nearest u = 0: its ends `lo`, `hi` and its centre's |u|
+// (m; infinity when there is none).
+double central_gap(const std::vector<double>& u, double width, double& lo, double& hi) {
+  double best_off = INFINITY;
+  for (std::size_t k = 1; k < u.size(); ++k) {
+    const double a = u[k - 1], b = u[k];
+    if (b - a < 0.6 * width || b - a > 1.6 * width) continue;
+    const double off = std::abs(0.5 * (a + b));
+    if (off < best_off) {
+      best_off = off;
+      lo = a;
+      hi = b;
+    }
+  }
+  return best_off;
+}
+
+// A groove of `width` and `depth` (m) in the gap centred at u = c under the top line `q` of
+// profile `pr` (at `origin`): root `depth` below the gap's centre along the top normal, edges
+// width / 2 to either side along the top, bisector = top normal.
+void place_in_gap(const Profile& pr, const Eigen::Vector3d& origin, const Eigen::Vector3d& q,
+                  double c, double width, double depth, GrooveSection& sec) {
+  const Eigen::Vector2d top_n = Eigen::Vector2d(-q[1], 1).normalized();
+  const Eigen::Vector2d centre(c, top_at(q, c));
+  const Eigen::Vector2d root = centre - depth * top_n;
+  const Eigen::Vector2d along_top(top_n.y(), -top_n.x());
+  sec.tangent = pr.t;
+  sec.root = pr.at(origin, root.x(), root.y());
+  const Eigen::Vector2d el = centre - 0.5 * width * along_top;
+  const Eigen::Vector2d er = centre + 0.5 * width * along_top;
+  sec.edge_left = pr.at(origin, el.x(), el.y());
+  sec.edge_right = pr.at(origin, er.x(), er.y());
+  sec.normal = (top_n.x() * pr.a + top_n.y() * pr.n).normalized();
+  sec.bisector = sec.normal;
+  sec.width = width;
+  sec.depth = depth;
+  sec.inferred = true;
+  sec.why = "inferred from a gap in the top surface";
+}
+
 }  // namespace
 
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
@@ -139,40 +180,14 @@ GrooveSection fit_gap_section(const Cloud& cloud, const std::vector<std::uint32_
     if (std::abs(p.y() - top_at(q, p.x())) <= tau) u.push_back(p.x());
   }
   std::sort(u.begin(), u.end());
-  double best_lo = 0, best_hi = 0, best_off = INFINITY;
-  for (std::size_t k = 1; k < u.size(); ++k) {
-    const double lo = u[k - 1], hi = u[k];
-    if (hi - lo < 0.6 * width || hi - lo > 1.6 * width) continue;
-    const double off = std::abs(0.5 * (lo + hi));
-    if (off < best_off) {
-      best_off = off;
-      best_lo = lo;
-      best_hi = hi;
-    }
-  }
-  if (!(best_off < 0.5 * W)) return sec;
+  double best_lo = 0, best_hi = 0;
+  if (!(central_gap(u, width, best_lo, best_hi) < 0.5 * W)) return sec;
   // Nothing may stand above the top inside the gap (that would be a rib, not a groove).
   for (const auto& p : inside) {
     if (p.x() > best_lo && p.x() < best_hi && p.y() > top_at(q, p.x()) + tau) return sec;
   }
-  const double c = 0.5 * (best_lo + best_hi);
-  const Eigen::Vector2d top_n = Eigen::Vector2d(-q[1], 1).normalized();
-  const Eigen::Vector2d centre(c, top_at(q, c));
-  const Eigen::Vector2d root = centre - depth * top_n;
-  const Eigen::Vector2d along_top(top_n.y(), -top_n.x());
-  sec.tangent = pr.t;
-  sec.root = pr.at(origin, root.x(), root.y());
-  const Eigen::Vector2d el = centre - 0.5 * width * along_top;
-  const Eigen::Vector2d er = centre + 0.5 * width * along_top;
-  sec.edge_left = pr.at(origin, el.x(), el.y());
-  sec.edge_right = pr.at(origin, er.x(), er.y());
-  sec.normal = (top_n.x() * pr.a + top_n.y() * pr.n).normalized();
-  sec.bisector = sec.normal;
-  sec.width = width;
-  sec.depth = depth;
+  place_in_gap(pr, origin, q, 0.5 * (best_lo + best_hi), width, depth, sec);
   sec.noise = sigma;
-  sec.inferred = true;
-  sec.why = "inferred from a gap in the top surface";
   return sec;
 }
 
