@@ -7,9 +7,8 @@
 #include <pcl/common/eigen.h>
 #include <pcl/search/kdtree.h>
 
-#include <groovetrace/robust.hpp>
-
 #include "pcl_peers.hpp"
+#include "robust/stages.hpp"
 
 namespace bench {
 namespace {

@@ -20,11 +20,11 @@
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
 #include <groovetrace/pipeline.hpp>
-#include <groovetrace/robust.hpp>
 #include <groovetrace/synth.hpp>
 #include <numeric>
 #include <random>
 
+#include "robust/stages.hpp"
 #include "support/opencl_support.hpp"
 #include "support/robust_scenes.hpp"
 

@@ -1,11 +1,11 @@
-// Concave-crease candidates (robust_candidates.cpp): a groove's root is concave, a convex edge
+// Concave-crease candidates (robust/candidates.cpp): a groove's root is concave, a convex edge
 // is not, and the threshold follows the scan's own noise.
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
 
+#include "robust/stages.hpp"
 #include "support/robust_scenes.hpp"
 
 namespace groovetrace {

@@ -1,4 +1,4 @@
-// The robust method end to end on small analytic scenes (robust_detect.cpp and the stages it
+// The robust method end to end on small analytic scenes (robust/detect.cpp and the stages it
 // runs): edges are not grooves, rings close, L-corners come out in order, the root is found,
 // and neither the point order nor the frame matters.
 #include <gtest/gtest.h>

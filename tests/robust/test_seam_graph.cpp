@@ -1,11 +1,12 @@
-// Seams as ordered curves (robust_seam_graph.cpp): order along the seam's own curve, rings
-// closed, L-corners kept, parallel seams apart.
+// Seams as ordered curves (robust/node_order.cpp, robust/curve.cpp): order along the seam's own
+// curve, rings closed, L-corners kept, parallel seams apart.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
+
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -1,10 +1,11 @@
-// The V model fitted across a seam (robust_section.cpp): root estimation against analytic V
-// profiles, and the shapes that are not V-grooves.
+// The V model fitted across a seam (robust/v_profile.cpp, robust/section.cpp): root estimation
+// against analytic V profiles, and the shapes that are not V-grooves.
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 #include <random>
+
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {

@@ -1,10 +1,10 @@
-// Stations along a seam anchored to the frame (robust_stations.cpp): where a seam's curve
+// Stations along a seam anchored to the frame (robust/stations.cpp): where a seam's curve
 // starts must not move the stations along it.
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <groovetrace/robust.hpp>
 
+#include "robust/stages.hpp"
 #include "robust/stations.hpp"
 
 namespace groovetrace {

@@ -1,4 +1,4 @@
-// Torch poses along a traced seam (robust_trajectory.cpp): arc-length spacing, slices, the
+// Torch poses along a traced seam (robust/trajectory.cpp): arc-length spacing, slices, the
 // travel direction convention, tool axis into the workpiece, continuous rotation vectors.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The V model's point distance (robust_vmodel.cpp): its analytic derivatives, which drive the
+// The V model's point distance (robust/vmodel.cpp): its analytic derivatives, which drive the
 // cross-section fit, against central differences of the distance itself.
 #include <gtest/gtest.h>
 

@@ -19,77 +19,7 @@
 
 namespace groovetrace {
 
-// --- Stage 1: candidates ------------------------------------------------------------------
-
-/// The cloud on voxels of `cell`, with the concavity of every voxel at radius `scale`.
-struct CreaseMap {
-  std::vector<Eigen::Vector3f> points;   ///< voxel centroids (m)
-  std::vector<Eigen::Vector3f> normals;  ///< plane normal at `scale`, towards the viewpoint
-  std::vector<float> concavity;          ///< m: upper envelope minus own height (> 0: concave)
-  std::vector<std::int32_t> voxel;       ///< per input point: its voxel, -1 if invalid
-  Eigen::Vector3f viewpoint{0, 0, 0};    ///< the cloud's viewpoint (m)
-  double median = 0.0;                   ///< of concavity over voxels (m)
-  double sigma = 0.0;                    ///< 1.4826 * MAD of concavity (m)
-  double threshold = 0.0;                ///< candidate threshold (m)
-};
-
-/// Voxelizes `cloud` and measures, per voxel, how deep it lies in its neighbourhood: along the
-/// plane normal (PCA of the voxels within `params.scale`), the 80th percentile of the
-/// neighbours' heights minus the voxel's own height averaged within 0.3 `scale`. The threshold
-/// is scale-free: median + threshold_k * 1.4826 MAD of the measure over the whole cloud. The
-/// per-voxel measure runs on `backend` (FeatureBackend::crease); without one, on the cpu.
-CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend);
-CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
-
-/// The voxel centroids of `map` as an unorganized cloud (same frame, metres; the map's
-/// viewpoint): what FeatureBackend::crease measures.
-Cloud voxel_cloud(const CreaseMap& map);
-
-/// Crease nodes: candidate voxels that are the deepest across the seam (non-maximum
-/// suppression in a slab across the local seam direction).
-struct CreaseNodes {
-  std::vector<std::int32_t> voxel;       ///< index into CreaseMap::points
-  std::vector<Eigen::Vector3d> tangent;  ///< unit seam direction from the candidates' spread
-};
-CreaseNodes crease_nodes(const CreaseMap& map, const RobustParams& params);
-
-// --- Stage 2: cross-section fit -----------------------------------------------------------
-
-/// A V fitted to a 2-D profile: u across the seam, v along the surface normal (out of the
-/// workpiece), both in metres in the section's frame. Left is u < root.
-struct VProfile {
-  bool ok = false;
-  std::string why;                    ///< why not ok
-  Eigen::Vector2d root{0, 0};         ///< intersection of the two wall lines
-  Eigen::Vector2d edge_left{0, 0};    ///< left wall meets the top surface
-  Eigen::Vector2d edge_right{0, 0};   ///< right wall meets the top surface
-  Eigen::Vector2d bisector{0, 1};     ///< unit bisector of the walls, out of the groove
-  Eigen::Vector3d top{0, 0, 0};       ///< top surface v = top[0] + top[1] u + top[2] u^2
-  double wall_left_deg = 0.0;         ///< left wall's inclination to the top surface at its edge
-  double wall_right_deg = 0.0;        ///< same, right
-  double opening_deg = 0.0;           ///< included angle between the walls
-  double width = 0.0;                 ///< |edge_right - edge_left| (m)
-  double depth = 0.0;                 ///< root below the top surface (m)
-  double noise = 0.0;                 ///< robust sigma of the top's residuals (m)
-  double rms = 0.0;                   ///< rms of the wall residuals (m)
-  int top_left = 0, top_right = 0;    ///< top-surface points left and right of the groove
-  int wall_left = 0, wall_right = 0;  ///< points that fitted each wall
-  /// One wall returned (almost) nothing (seen at a grazing angle): that wall's edge is where the
-  /// top surface ends, the V taken symmetric about the top normal through the opening.
-  bool one_wall = false;
-};
-
-/// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
-/// quadratic (so pipes work), the points clearly below it as two walls (robust orthogonal line
-/// fits, iterated with their intersection), edges where walls meet the top. `ok` only when the
-/// profile is a V: both walls inclined into the material, both top sides present, depth above
-/// the noise. Rims and root, which sensors round off, do not enter the wall fits.
-/// `symmetric`: the V is known to be symmetric (the seam's walls dip alike): after the free
-/// fit, the walls are refitted with equal dips about the top normal through the root, so a
-/// poorly sampled wall (a grazing view puts two image rows on it) takes its slope from the
-/// other and only its offset from its own points.
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window,
-                       bool symmetric = false);
+// --- Results ------------------------------------------------------------------------------
 
 /// A fitted cross-section in 3-D.
 struct GrooveSection {
@@ -103,51 +33,16 @@ struct GrooveSection {
   Eigen::Vector3d edge_left{0, 0, 0};  ///< top edges (m); left = -across side
   Eigen::Vector3d edge_right{0, 0, 0};
   double width = 0, depth = 0, opening_deg = 0, rms = 0, noise = 0;
-  int support = 0;        ///< profile points in the slab
-  bool one_wall = false;  ///< see VProfile::one_wall
+  int support = 0;  ///< profile points in the slab
+  /// One wall returned (almost) nothing (seen at a grazing angle): its edge is where the top
+  /// surface ends, the V taken symmetric about the top normal through the opening.
+  bool one_wall = false;
   /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
   /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
   bool inferred = false;
   /// across = normal x tangent: u grows towards edge_right.
   Eigen::Vector3d across() const { return normal.cross(tangent).normalized(); }
 };
-
-/// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
-/// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)
-/// of origin across it. `normal_hint` orients the profile (towards the viewpoint).
-/// `symmetric` as in fit_v_profile.
-GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
-                          const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
-                          const Eigen::Vector3d& normal_hint, double slab, double half_window,
-                          bool symmetric = false);
-
-/// Where the walls return nothing (seen at a grazing angle) a groove still shows as a gap in
-/// the top surface. Fits that instead of a V: both sides carry top surface, the gap nearest
-/// the centre holds no point and is 0.6-1.6 times `width` (m) wide. The section has
-/// `inferred` set, `ok` false, the root `depth` (m) below the gap's centre, edges at the
-/// gap's centre +- width / 2, bisector = top normal.
-GrooveSection fit_gap_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
-                              const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
-                              const Eigen::Vector3d& normal_hint, double slab, double half_window,
-                              double width, double depth);
-
-// --- Stage 3: seams as ordered curves -----------------------------------------------------
-
-/// One ordered chain of nodes.
-struct NodePath {
-  std::vector<int> nodes;  ///< indices into the input, in order along the seam
-  bool closed = false;     ///< the ends meet: a ring
-};
-
-/// Orders scattered seam nodes into curves: nodes within `link` (m) are joined when the link
-/// runs roughly along a node's tangent; the minimum spanning tree of each connected part is
-/// walked along its longest path (the tree's diameter), so L-corners and S-curves come out in
-/// order; the nodes near a path are then removed and the rest searched again for further
-/// seams (branches). Paths with fewer than `min_nodes` nodes are dropped. A path whose ends
-/// are within `link` of each other and which is long against `link` is closed.
-std::vector<NodePath> order_nodes(const std::vector<Eigen::Vector3d>& points,
-                                  const std::vector<Eigen::Vector3d>& tangents, double link,
-                                  std::size_t min_nodes);
 
 /// A seam's centre line, resampled at a fixed arc-length spacing.
 struct SeamCurve {
@@ -158,16 +53,6 @@ struct SeamCurve {
   bool closed = false;
   double length = 0.0;  ///< m (closed: the whole ring)
 };
-
-/// Smooths an ordered polyline by local quadratic fits over 3 `half_window` (m) of arc length,
-/// keeping sharp corners as corners, and resamples it every `spacing` (m). A corner is a turn
-/// of over 45 degrees between the chords 3 half_window before and after a point, measured in
-/// the surface (the plane normal to `normals`, one per point, when given: depth noise of the
-/// roots must not look like a corner), kept at its maximum within 6 half_window.
-SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed, double half_window,
-                       double spacing, const std::vector<Eigen::Vector3d>& normals = {});
-
-// --- Stage 4: seam candidates, scores, region ---------------------------------------------
 
 /// One candidate seam with its sections and score (docs/method-robust.md, "Score").
 struct SeamCandidate {
@@ -185,20 +70,11 @@ struct SeamCandidate {
   std::string reason;  ///< why rejected (empty when accepted)
 };
 
-/// Scores a candidate and decides whether it is a V-groove seam (fills score, accepted,
-/// reason and the medians).
-void score_seam(SeamCandidate& seam, const RobustParams& params);
-
-/// Labels groove points: a point is groove when its viewing ray (from cloud.viewpoint) passes
-/// through the opening of an accepted seam (between the two fitted top edges of the nearest
-/// sections) and the point lies at or below that opening. Returns 1/0 per point.
-std::vector<std::uint8_t> label_grooves(const Cloud& cloud,
-                                        const std::vector<SeamCandidate>& seams);
-
 /// Torch poses along a seam: positions on the smoothed root line every `step` (or in
 /// `slices` equal parts), tool z = -wall bisector, tool x along the seam; rotation vectors
-/// continuous. A closed seam ends where it started. Travel runs so that the end lies at
-/// larger x of the cloud's frame than the start (ties: y).
+/// continuous. An open seam ends at larger x of the cloud's frame than it starts (ties: y, then
+/// z); a closed seam starts at its smallest x, runs counter-clockwise about its mean top
+/// normal and ends where it started.
 Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
 /// Everything the robust method decided.

@@ -11,11 +11,12 @@
 #include <array>
 #include <climits>
 #include <cmath>
-#include "core/eigen3.hpp"
 #include <groovetrace/features.hpp>
-#include <groovetrace/robust.hpp>
 
+#include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
+#include "core/stats.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {
@@ -108,12 +109,8 @@ std::pair<double, double> robust_location_scale(const std::vector<float>& values
     if (std::isfinite(x)) v.push_back(x);
   }
   if (v.empty()) return {NAN, NAN};
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  const double median = v[mid];
-  for (float& x : v) x = static_cast<float>(std::abs(x - median));
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return {median, 1.4826 * v[mid]};
+  const double median = upper_median(v);
+  return {median, mad_sigma(std::move(v), median)};
 }
 
 Cloud as_cloud(const std::vector<Eigen::Vector3f>& points) {
@@ -126,6 +123,64 @@ Cloud as_cloud(const std::vector<Eigen::Vector3f>& points) {
     c.z[i] = points[i].z();
   }
   return c;
+}
+
+// The candidate voxels (concavity above the threshold): their indices and centroids (m).
+struct Candidates {
+  std::vector<std::int32_t> voxel;
+  std::vector<Eigen::Vector3f> points;
+};
+
+Candidates candidates_of(const CreaseMap& map) {
+  Candidates cand;
+  for (std::size_t v = 0; v < map.points.size(); ++v) {
+    if (std::isfinite(map.concavity[v]) && map.concavity[v] > map.threshold) {
+      cand.voxel.push_back(static_cast<std::int32_t>(v));
+      cand.points.push_back(map.points[v]);
+    }
+  }
+  return cand;
+}
+
+// The seam direction `t` (unit) at candidate k: the long axis of the candidates within
+// `radius` (m), weighted by how far above the threshold they are (the deep core near the root
+// is a line even where the band is wide), in the tangent plane. False when none weighs.
+bool seam_direction(const CreaseMap& map, const Candidates& cand, const NeighborGrid& grid,
+                    float radius, std::int64_t k, Eigen::Vector3d& t) {
+  const Eigen::Vector3f p = cand.points[k];
+  const Eigen::Vector3d n = map.normals[cand.voxel[k]].cast<double>();
+  double sw = 0;
+  Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
+  grid.for_each_within(p, radius, [&](std::uint32_t j, float) {
+    const double w = map.concavity[cand.voxel[j]] - map.threshold;
+    Eigen::Vector3d d = (cand.points[j] - p).cast<double>();
+    d -= d.dot(n) * n;
+    sw += w;
+    s1 += w * d;
+    s2 += w * d * d.transpose();
+  });
+  if (sw <= 0) return false;
+  const Eigen::Vector3d mean = s1 / sw;
+  const SymEigen3 eig = eigen_sym3(s2 / sw - mean * mean.transpose());
+  t = eig.vectors.col(2);
+  return true;
+}
+
+// Whether candidate k is the deepest across the seam: no candidate within `radius` (m) and
+// `half` (m) of it along `t` is deeper (ties: the lower index wins).
+bool deepest_across(const CreaseMap& map, const Candidates& cand, const NeighborGrid& grid,
+                    float radius, double half, std::int64_t k, const Eigen::Vector3d& t) {
+  const Eigen::Vector3f p = cand.points[k];
+  const double ck = map.concavity[cand.voxel[k]];
+  bool is_max = true;
+  grid.for_each_within(p, radius, [&](std::uint32_t j, float) {
+    if (!is_max || static_cast<std::int64_t>(j) == k) return;
+    if (std::abs((cand.points[j] - p).cast<double>().dot(t)) > half) return;
+    const double cj = map.concavity[cand.voxel[j]];
+    if (cj > ck || (cj == ck && static_cast<std::int64_t>(j) < k)) is_max = false;
+  });
+  return is_max;
 }
 
 }  // namespace
@@ -189,63 +244,26 @@ Cloud voxel_cloud(const CreaseMap& map) {
 }
 
 CreaseNodes crease_nodes(const CreaseMap& map, const RobustParams& params) {
-  std::vector<std::int32_t> cand;
-  std::vector<Eigen::Vector3f> cand_points;
-  for (std::size_t v = 0; v < map.points.size(); ++v) {
-    if (std::isfinite(map.concavity[v]) && map.concavity[v] > map.threshold) {
-      cand.push_back(static_cast<std::int32_t>(v));
-      cand_points.push_back(map.points[v]);
-    }
-  }
   CreaseNodes nodes;
-  if (cand.empty()) return nodes;
-  const Cloud cc = as_cloud(cand_points);
+  const Candidates cand = candidates_of(map);
+  if (cand.voxel.empty()) return nodes;
   const float radius = static_cast<float>(params.scale);
-  const NeighborGrid grid(cc, radius);
-  const double thr = map.threshold;
-  const std::int64_t count = static_cast<std::int64_t>(cand.size());
-  std::vector<std::uint8_t> keep(cand.size(), 0);
-  std::vector<Eigen::Vector3d> tangent(cand.size(), Eigen::Vector3d::Zero());
+  const NeighborGrid grid(as_cloud(cand.points), radius);
+  const std::int64_t count = static_cast<std::int64_t>(cand.voxel.size());
+  std::vector<std::uint8_t> keep(cand.voxel.size(), 0);
+  std::vector<Eigen::Vector3d> tangent(cand.voxel.size(), Eigen::Vector3d::Zero());
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t k = 0; k < count; ++k) {
-    const Eigen::Vector3f p = cand_points[k];
-    const Eigen::Vector3d n = map.normals[cand[k]].cast<double>();
-    const double ck = map.concavity[cand[k]];
-    // Seam direction: the long axis of the candidates around, weighted by how far above the
-    // threshold they are (the deep core near the root is a line even where the band is wide),
-    // in the tangent plane.
-    double sw = 0;
-    Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
-    grid.for_each_within(p, radius, [&](std::uint32_t j, float) {
-      const double w = map.concavity[cand[j]] - thr;
-      Eigen::Vector3d d = (cand_points[j] - p).cast<double>();
-      d -= d.dot(n) * n;
-      sw += w;
-      s1 += w * d;
-      s2 += w * d * d.transpose();
-    });
-    if (sw <= 0) continue;
-    const Eigen::Vector3d mean = s1 / sw;
-    const SymEigen3 eig = eigen_sym3(s2 / sw - mean * mean.transpose());
-    const Eigen::Vector3d t = eig.vectors.col(2);
-    // Deepest across the seam: no candidate in a one-cell slab across t is deeper.
-    bool is_max = true;
-    const double half = params.cell;
-    grid.for_each_within(p, radius, [&](std::uint32_t j, float) {
-      if (!is_max || static_cast<std::int64_t>(j) == k) return;
-      if (std::abs((cand_points[j] - p).cast<double>().dot(t)) > half) return;
-      const double cj = map.concavity[cand[j]];
-      if (cj > ck || (cj == ck && static_cast<std::int64_t>(j) < k)) is_max = false;
-    });
-    if (is_max) {
+    Eigen::Vector3d t;
+    if (!seam_direction(map, cand, grid, radius, k, t)) continue;
+    if (deepest_across(map, cand, grid, radius, params.cell, k, t)) {
       keep[k] = 1;
       tangent[k] = t;
     }
   }
-  for (std::size_t k = 0; k < cand.size(); ++k) {
+  for (std::size_t k = 0; k < cand.voxel.size(); ++k) {
     if (!keep[k]) continue;
-    nodes.voxel.push_back(cand[k]);
+    nodes.voxel.push_back(cand.voxel[k]);
     nodes.tangent.push_back(tangent[k]);
   }
   return nodes;

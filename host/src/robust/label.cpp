@@ -10,9 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
 
 #include "core/neighbor_grid.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {
@@ -24,54 +24,94 @@ struct Opening {
   int end;  // +1 / -1: the seam's open end lies along +along / -along; 0: inside
 };
 
+// The larger spacing (m) from section k to its neighbours along the seam (wrapping on rings).
+double station_spacing(const SeamCandidate& seam, std::size_t k) {
+  const auto& secs = seam.sections;
+  const std::size_t n = secs.size();
+  const Eigen::Vector3d& root = secs[k].root;
+  double prev = k > 0 ? (root - secs[k - 1].root).norm() : 0;
+  double next = k + 1 < n ? (secs[k + 1].root - root).norm() : 0;
+  if (seam.closed) {
+    if (k == 0) prev = (root - secs[n - 1].root).norm();
+    if (k + 1 == n) next = (secs[0].root - root).norm();
+  }
+  return std::max(prev, next);
+}
+
+// The opening of section k of `seam`; false when its edges coincide.
+bool opening_of(const SeamCandidate& seam, std::size_t k, Opening& o) {
+  const std::size_t n = seam.sections.size();
+  const GrooveSection& s = seam.sections[k];
+  o.centre = 0.5 * (s.edge_left + s.edge_right);
+  const Eigen::Vector3d chord = s.edge_right - s.edge_left;
+  o.half_width = 0.5 * chord.norm();
+  if (!(o.half_width > 0)) return false;
+  o.across = chord / (2 * o.half_width);
+  o.along = (s.tangent - s.tangent.dot(o.across) * o.across).normalized();
+  o.out = o.across.cross(o.along);
+  if (o.out.dot(s.normal) < 0) o.out = -o.out;
+  // Half the spacing to the neighbours, with overlap so that the fan of sections around a
+  // bend leaves no gaps; the open ends reach one spacing further (the seam runs to the
+  // part's edge).
+  const double spacing = station_spacing(seam, k);
+  o.reach = 0.6 * spacing;
+  o.end = 0;
+  if (!seam.closed && n > 1 && (k == 0 || k + 1 == n)) {
+    // Does `along` point out of the seam here?
+    const Eigen::Vector3d inward =
+        k == 0 ? seam.sections[1].root - s.root : seam.sections[n - 2].root - s.root;
+    o.end = inward.dot(o.along) < 0 ? 1 : -1;
+  }
+  o.tolerance = std::max(3 * s.noise, 0.1 * s.depth);
+  o.disc = false;
+  for (double c : seam.curve.corners) {
+    if (std::abs(s.s - c) <= spacing) o.disc = true;
+  }
+  return true;
+}
+
+// The openings of the accepted seams' sections. `radius`: how far (m) from its opening's
+// centre a groove point can lie - half a width across, a depth below and a reach along.
+std::vector<Opening> openings_of(const std::vector<SeamCandidate>& seams, double& radius) {
+  std::vector<Opening> openings;
+  radius = 0;
+  for (const SeamCandidate& seam : seams) {
+    if (!seam.accepted) continue;
+    for (std::size_t k = 0; k < seam.sections.size(); ++k) {
+      Opening o;
+      if (!opening_of(seam, k, o)) continue;
+      const GrooveSection& s = seam.sections[k];
+      radius = std::max(radius, o.half_width + s.depth + o.reach + o.tolerance);
+      openings.push_back(o);
+    }
+  }
+  return openings;
+}
+
+// Whether point p, seen along the unit `ray` from the viewpoint, lies in the groove behind
+// opening o: its ray crosses the opening and it is not in front of it.
+bool behind(const Opening& o, const Eigen::Vector3d& p, const Eigen::Vector3d& ray) {
+  const double height = (p - o.centre).dot(o.out);
+  if (height > o.tolerance) return false;  // in front of the opening: a top surface or beyond
+  const double dn = ray.dot(o.out);
+  if (std::abs(dn) < 1e-6) return false;
+  const Eigen::Vector3d q = p + ((o.centre - p).dot(o.out) / dn) * ray;
+  const Eigen::Vector3d r = q - o.centre;
+  if (o.disc) return (r - r.dot(o.out) * o.out).norm() <= o.half_width;
+  if (std::abs(r.dot(o.along)) > o.reach) return false;
+  // Past an open end (a plate's edge) the ray may pass the opening's plane and meet the
+  // table beyond the part: the point itself must lie within the seam's end too.
+  if (o.end != 0 && o.end * (p - o.centre).dot(o.along) > o.reach) return false;
+  return std::abs(r.dot(o.across)) <= o.half_width;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> label_grooves(const Cloud& cloud,
                                         const std::vector<SeamCandidate>& seams) {
   std::vector<std::uint8_t> label(cloud.size(), 0);
-  std::vector<Opening> openings;
   double radius = 0;
-  for (const SeamCandidate& seam : seams) {
-    if (!seam.accepted) continue;
-    const std::size_t n = seam.sections.size();
-    for (std::size_t k = 0; k < n; ++k) {
-      const GrooveSection& s = seam.sections[k];
-      Opening o;
-      o.centre = 0.5 * (s.edge_left + s.edge_right);
-      const Eigen::Vector3d chord = s.edge_right - s.edge_left;
-      o.half_width = 0.5 * chord.norm();
-      if (!(o.half_width > 0)) continue;
-      o.across = chord / (2 * o.half_width);
-      o.along = (s.tangent - s.tangent.dot(o.across) * o.across).normalized();
-      o.out = o.across.cross(o.along);
-      if (o.out.dot(s.normal) < 0) o.out = -o.out;
-      // Half the spacing to the neighbours, with overlap so that the fan of sections around a
-      // bend leaves no gaps; the open ends reach one spacing further (the seam runs to the
-      // part's edge).
-      double prev = k > 0 ? (s.root - seam.sections[k - 1].root).norm() : 0;
-      double next = k + 1 < n ? (seam.sections[k + 1].root - s.root).norm() : 0;
-      if (seam.closed) {
-        if (k == 0) prev = (s.root - seam.sections[n - 1].root).norm();
-        if (k + 1 == n) next = (seam.sections[0].root - s.root).norm();
-      }
-      const double spacing = std::max(prev, next);
-      o.reach = 0.6 * spacing;
-      o.end = 0;
-      if (!seam.closed && n > 1 && (k == 0 || k + 1 == n)) {
-        // Does `along` point out of the seam here?
-        const Eigen::Vector3d inward =
-            k == 0 ? seam.sections[1].root - s.root : seam.sections[n - 2].root - s.root;
-        o.end = inward.dot(o.along) < 0 ? 1 : -1;
-      }
-      o.tolerance = std::max(3 * s.noise, 0.1 * s.depth);
-      o.disc = false;
-      for (double c : seam.curve.corners) {
-        if (std::abs(s.s - c) <= spacing) o.disc = true;
-      }
-      radius = std::max(radius, o.half_width + s.depth + o.reach + o.tolerance);
-      openings.push_back(o);
-    }
-  }
+  const std::vector<Opening> openings = openings_of(seams, radius);
   if (openings.empty()) return label;
   Cloud centres;
   centres.resize(openings.size());
@@ -81,8 +121,6 @@ std::vector<std::uint8_t> label_grooves(const Cloud& cloud,
     centres.y[k] = static_cast<float>(openings[k].centre.y());
     centres.z[k] = static_cast<float>(openings[k].centre.z());
   }
-  // A groove point lies at most half a width across, a depth below and a reach along from
-  // its section's opening centre.
   radius *= 1.05;
   const NeighborGrid grid(centres, static_cast<float>(radius));
   const Eigen::Vector3d eye = cloud.viewpoint.cast<double>();
@@ -94,23 +132,7 @@ std::vector<std::uint8_t> label_grooves(const Cloud& cloud,
     const Eigen::Vector3d ray = (p - eye).normalized();
     bool inside = false;
     grid.for_each_within(cloud.point(i), static_cast<float>(radius), [&](std::uint32_t k, float) {
-      if (inside) return;
-      const Opening& o = openings[k];
-      const double height = (p - o.centre).dot(o.out);
-      if (height > o.tolerance) return;  // in front of the opening: a top surface or beyond
-      const double dn = ray.dot(o.out);
-      if (std::abs(dn) < 1e-6) return;
-      const Eigen::Vector3d q = p + ((o.centre - p).dot(o.out) / dn) * ray;
-      const Eigen::Vector3d r = q - o.centre;
-      if (o.disc) {
-        inside = (r - r.dot(o.out) * o.out).norm() <= o.half_width;
-        return;
-      }
-      if (std::abs(r.dot(o.along)) > o.reach) return;
-      // Past an open end (a plate's edge) the ray may pass the opening's plane and meet the
-      // table beyond the part: the point itself must lie within the seam's end too.
-      if (o.end != 0 && o.end * (p - o.centre).dot(o.along) > o.reach) return;
-      inside = std::abs(r.dot(o.across)) <= o.half_width;
+      if (!inside) inside = behind(openings[k], p, ray);
     });
     label[i] = inside ? 1 : 0;
   }

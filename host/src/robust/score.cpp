@@ -7,25 +7,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/robust.hpp>
+
+#include "core/stats.hpp"
+#include "robust/stages.hpp"
 
 namespace groovetrace {
 namespace {
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
-
 // 1.4826 MAD / median: a robust coefficient of variation.
 double relative_spread(const std::vector<double>& v) {
-  const double med = median_of(v);
+  const double med = upper_median(v);
   if (!(med > 0)) return 1.0;
-  std::vector<double> dev(v.size());
-  for (std::size_t k = 0; k < v.size(); ++k) dev[k] = std::abs(v[k] - med);
-  return 1.4826 * median_of(dev) / med;
+  return mad_sigma(v, med) / med;
 }
 
 }  // namespace
@@ -43,10 +36,10 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
   seam.length = seam.curve.length;
   seam.closed = seam.curve.closed;
   seam.ok_fraction = total > 0 ? static_cast<double>(width.size()) / total : 0.0;
-  seam.width = median_of(width);
-  seam.depth = median_of(depth);
-  seam.opening_deg = median_of(opening);
-  seam.fit_quality = quality.empty() ? 0.0 : median_of(quality);
+  seam.width = upper_median(width);
+  seam.depth = upper_median(depth);
+  seam.opening_deg = upper_median(opening);
+  seam.fit_quality = quality.empty() ? 0.0 : upper_median(quality);
   seam.consistency =
       width.empty() ? 0.0 : std::max(0.0, 1.0 - relative_spread(width) - relative_spread(opening));
   seam.score = seam.length * 1000.0 * seam.ok_fraction * seam.fit_quality * seam.consistency;

@@ -1,4 +1,4 @@
-// Stations along a seam anchored to the cloud's frame (see robust_stations.hpp).
+// Stations along a seam anchored to the cloud's frame (see stations.hpp).
 
 #include "robust/stations.hpp"
 
@@ -41,23 +41,15 @@ std::vector<double> anchors(const SeamCurve& dense, double lattice) {
   return out;
 }
 
-}  // namespace
-
-SeamCurve anchored_stations(const SeamCurve& dense, double spacing) {
-  const std::size_t n = dense.points.size();
-  if (n < 2 || !(dense.length > 0) || !(spacing > 0)) return dense;
+// Station arc lengths (m), sorted. From every anchor, stations `spacing` (m) apart both ways
+// up to half-way to the next anchor. Arc length drifts between two runs where the curve wobbles
+// differently (60 um over 100 mm of a 640x480 scan); anchored every lattice spacing, no station
+// lies more than half a lattice from its anchor. Where two series meet, the gap between them
+// is whatever is left (0 to `spacing`): a threshold there (one station more or less) would be
+// a new place for a micrometre to flip a decision. An open curve keeps its ends as stations
+// where they lie over half a spacing from the nearest one.
+std::vector<double> station_arcs(const SeamCurve& dense, double spacing) {
   const double L = dense.length;
-  SeamCurve out;
-  out.closed = dense.closed;
-  out.length = L;
-  out.corners = dense.corners;
-
-  // Station arc lengths: from every anchor, stations `spacing` apart both ways up to half-way
-  // to the next anchor. Arc length drifts between two runs where the curve wobbles
-  // differently (60 um over 100 mm of a 640x480 scan); anchored every lattice spacing, no
-  // station lies more than half a lattice from its anchor. Where two series meet, the gap
-  // between them is whatever is left (0 to `spacing`): a threshold there (one station more
-  // or less) would be a new place for a micrometre to flip a decision.
   std::vector<double> A = anchors(dense, kAnchorLattice * spacing);
   std::vector<double> S;
   if (A.empty()) {
@@ -81,14 +73,25 @@ SeamCurve anchored_stations(const SeamCurve& dense, double spacing) {
   }
   std::sort(S.begin(), S.end());
   if (!dense.closed) {
-    // The ends, where they lie over half a spacing from the nearest station.
     if (S.empty() || S.front() > 0.5 * spacing) S.insert(S.begin(), 0.0);
     if (L - S.back() > 0.5 * spacing) S.push_back(L);
   }
+  return S;
+}
 
+}  // namespace
+
+SeamCurve anchored_stations(const SeamCurve& dense, double spacing) {
+  const std::size_t n = dense.points.size();
+  if (n < 2 || !(dense.length > 0) || !(spacing > 0)) return dense;
+  const double L = dense.length;
+  SeamCurve out;
+  out.closed = dense.closed;
+  out.length = L;
+  out.corners = dense.corners;
   // Positions and tangents interpolated on the dense curve.
   std::size_t seg = 0;
-  for (double s0 : S) {
+  for (double s0 : station_arcs(dense, spacing)) {
     while (seg + 1 < n && dense.s[seg + 1] < s0) ++seg;
     const std::size_t next = seg + 1 < n ? seg + 1 : (dense.closed ? 0 : seg);
     const double s1 = seg + 1 < n ? dense.s[seg + 1] : (dense.closed ? L : dense.s[seg]);

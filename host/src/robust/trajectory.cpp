@@ -8,64 +8,107 @@
 #include <groovetrace/robust.hpp>
 
 namespace groovetrace {
+namespace {
+
+// A ring starts at its smallest x (ties: y) and runs counter-clockwise about its mean surface
+// normal.
+void orient_ring(std::vector<GrooveSection>& secs) {
+  std::size_t first = 0;
+  for (std::size_t k = 1; k < secs.size(); ++k) {
+    const Eigen::Vector3d& a = secs[k].root;
+    const Eigen::Vector3d& b = secs[first].root;
+    if (a.x() < b.x() || (a.x() == b.x() && a.y() < b.y())) first = k;
+  }
+  std::rotate(secs.begin(), secs.begin() + static_cast<std::ptrdiff_t>(first), secs.end());
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
+  for (const auto& s : secs) {
+    centre += s.root;
+    up += s.normal;
+  }
+  centre /= static_cast<double>(secs.size());
+  Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < secs.size(); ++k) {
+    turn += (secs[k].root - centre).cross(secs[(k + 1) % secs.size()].root - centre);
+  }
+  if (turn.dot(up) < 0) std::reverse(secs.begin() + 1, secs.end());
+}
+
+// An open seam ends at larger x than it starts (ties: y, then z).
+void orient_open(std::vector<GrooveSection>& secs) {
+  const Eigen::Vector3d d = secs.back().root - secs.front().root;
+  const double eps = 1e-9;
+  const bool backwards = d.x() < -eps || (std::abs(d.x()) <= eps &&
+                                          (d.y() < -eps || (std::abs(d.y()) <= eps && d.z() < 0)));
+  if (backwards) std::reverse(secs.begin(), secs.end());
+}
+
+// The torch's path: the polyline through the roots (m; closed: back to the start) with its arc
+// length S (m), and at each root the wall bisector B and the travel tangent T. Tangents are
+// the sections' own, from the seam curve smoothed over 18 mm, turned along the travel: the
+// chord between neighbouring roots 1.5 mm apart would turn with their jitter (0.4 mm across
+// tilts it 13 deg at 640x480).
+struct TorchPath {
+  std::vector<Eigen::Vector3d> P, B, T;
+  std::vector<double> S;
+};
+
+TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
+  TorchPath path;
+  const std::size_t n = secs.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    path.P.push_back(secs[k].root);
+    path.B.push_back(secs[k].bisector);
+    const std::size_t next = closed ? (k + 1) % n : std::min(k + 1, n - 1);
+    const std::size_t prev = closed ? (k + n - 1) % n : (k > 0 ? k - 1 : 0);
+    Eigen::Vector3d t = secs[k].tangent;
+    if (t.dot(secs[next].root - secs[prev].root) < 0) t = -t;
+    path.T.push_back(t);
+  }
+  if (closed) {
+    path.P.push_back(path.P.front());
+    path.B.push_back(path.B.front());
+    path.T.push_back(path.T.front());
+  }
+  path.S.assign(path.P.size(), 0.0);
+  for (std::size_t k = 1; k < path.P.size(); ++k) {
+    path.S[k] = path.S[k - 1] + (path.P[k] - path.P[k - 1]).norm();
+  }
+  return path;
+}
+
+// The waypoint at fraction f of segment seg of `path`; `direction` is the travel where the
+// path gives none.
+Waypoint waypoint_at(const TorchPath& path, std::size_t seg, double f,
+                     const Eigen::Vector3d& direction) {
+  const auto &P = path.P, &B = path.B, &T = path.T;
+  Waypoint w;
+  w.rotation_vector.setZero();
+  w.euler_zyx_deg.setZero();
+  w.position = P[seg] + f * (P[seg + 1] - P[seg]);
+  Eigen::Vector3d bis = ((1 - f) * B[seg] + f * B[seg + 1]);
+  if (!(bis.norm() > 1e-9)) bis = B[seg];
+  Eigen::Vector3d travel = (1 - f) * T[seg] + f * T[seg + 1];
+  if (!(travel.norm() > 1e-9)) travel = P[seg + 1] - P[seg];
+  if (!(travel.norm() > 1e-12)) travel = direction;
+  w.orientation = tool_orientation(bis.normalized(), travel.normalized());
+  w.support = 0;
+  return w;
+}
+
+}  // namespace
 
 Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params) {
   std::vector<GrooveSection> secs = seam.sections;
   if (secs.size() < 2) throw NoGrooveError("seam has fewer than 2 sections: no trajectory");
   const bool closed = seam.closed;
-
-  // Travel direction: open seams end at larger x than they start (ties: y, then z); rings
-  // start at their smallest x and run counter-clockwise about the mean surface normal.
   if (closed) {
-    std::size_t first = 0;
-    for (std::size_t k = 1; k < secs.size(); ++k) {
-      const Eigen::Vector3d& a = secs[k].root;
-      const Eigen::Vector3d& b = secs[first].root;
-      if (a.x() < b.x() || (a.x() == b.x() && a.y() < b.y())) first = k;
-    }
-    std::rotate(secs.begin(), secs.begin() + static_cast<std::ptrdiff_t>(first), secs.end());
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
-    for (const auto& s : secs) {
-      centre += s.root;
-      up += s.normal;
-    }
-    centre /= static_cast<double>(secs.size());
-    Eigen::Vector3d turn = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < secs.size(); ++k) {
-      turn += (secs[k].root - centre).cross(secs[(k + 1) % secs.size()].root - centre);
-    }
-    if (turn.dot(up) < 0) std::reverse(secs.begin() + 1, secs.end());
+    orient_ring(secs);
   } else {
-    const Eigen::Vector3d d = secs.back().root - secs.front().root;
-    const double eps = 1e-9;
-    const bool backwards =
-        d.x() < -eps ||
-        (std::abs(d.x()) <= eps && (d.y() < -eps || (std::abs(d.y()) <= eps && d.z() < 0)));
-    if (backwards) std::reverse(secs.begin(), secs.end());
+    orient_open(secs);
   }
-
-  // Polyline through the roots (closed: back to the start), its arc length. Tangents: the
-  // sections' own, from the seam curve smoothed over 18 mm, turned along the travel. The chord
-  // between neighbouring roots 1.5 mm apart would turn with their jitter (0.4 mm across
-  // tilts it 13 deg at 640x480).
-  std::vector<Eigen::Vector3d> P, B, T;
-  const std::size_t n = secs.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    P.push_back(secs[k].root);
-    B.push_back(secs[k].bisector);
-    const std::size_t next = closed ? (k + 1) % n : std::min(k + 1, n - 1);
-    const std::size_t prev = closed ? (k + n - 1) % n : (k > 0 ? k - 1 : 0);
-    Eigen::Vector3d t = secs[k].tangent;
-    if (t.dot(secs[next].root - secs[prev].root) < 0) t = -t;
-    T.push_back(t);
-  }
-  if (closed) {
-    P.push_back(P.front());
-    B.push_back(B.front());
-    T.push_back(T.front());
-  }
-  std::vector<double> S(P.size(), 0.0);
-  for (std::size_t k = 1; k < P.size(); ++k) S[k] = S[k - 1] + (P[k] - P[k - 1]).norm();
+  const TorchPath path = torch_path(secs, closed);
+  const std::vector<Eigen::Vector3d>& P = path.P;
+  const std::vector<double>& S = path.S;
   const double length = S.back();
   if (!(length > 0)) throw NoGrooveError("seam has zero length: no trajectory");
 
@@ -88,18 +131,7 @@ Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params
     while (seg + 2 < P.size() && S[seg + 1] < s0) ++seg;
     const double span = S[seg + 1] - S[seg];
     const double f = span > 0 ? std::clamp((s0 - S[seg]) / span, 0.0, 1.0) : 0.0;
-    Waypoint w;
-    w.rotation_vector.setZero();
-    w.euler_zyx_deg.setZero();
-    w.position = P[seg] + f * (P[seg + 1] - P[seg]);
-    Eigen::Vector3d bis = ((1 - f) * B[seg] + f * B[seg + 1]);
-    if (!(bis.norm() > 1e-9)) bis = B[seg];
-    Eigen::Vector3d travel = (1 - f) * T[seg] + f * T[seg + 1];
-    if (!(travel.norm() > 1e-9)) travel = P[seg + 1] - P[seg];
-    if (!(travel.norm() > 1e-12)) travel = traj.direction;
-    w.orientation = tool_orientation(bis.normalized(), travel.normalized());
-    w.support = 0;
-    traj.waypoints.push_back(w);
+    traj.waypoints.push_back(waypoint_at(path, seg, f, traj.direction));
   }
   if (closed && params.slices > 0) {
     // `slices` waypoints around a ring, the last returning to the first.

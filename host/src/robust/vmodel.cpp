@@ -1,4 +1,4 @@
-// Distance of a profile point to the V model, and its derivatives (robust_vmodel.hpp).
+// Distance of a profile point to the V model, and its derivatives (vmodel.hpp).
 
 #include "robust/vmodel.hpp"
 

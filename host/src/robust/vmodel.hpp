@@ -1,16 +1,22 @@
 #pragma once
 // The robust method's V model of a cross-section (internal): a top curve, two walls, a root,
 // and the signed distance of a profile point to it with its derivatives, for the
-// Gauss-Newton fit in robust_section.cpp. Profile coordinates: u across the seam, v along the
+// Gauss-Newton fit in v_profile.cpp. Profile coordinates: u across the seam, v along the
 // top normal (out of the workpiece), metres.
 
 #include <Eigen/Core>
 #include <utility>
+#include <vector>
 
 namespace groovetrace::robust_detail {
 
 /// Top curve height v (m) at u (m): q0 + q1 u + q2 u^2.
 inline double top_at(const Eigen::Vector3d& q, double u) { return q[0] + q[1] * u + q[2] * u * u; }
+
+/// The top curve fitted to profile points `pts` (m) by Tukey-reweighted least squares in v:
+/// degree 2 gives q0 + q1 u + q2 u^2, degree 1 a line (q2 = 0). Returns the coefficients and
+/// the robust sigma of the final fit's residuals (m). Defined in v_profile.cpp.
+std::pair<Eigen::Vector3d, double> fit_poly(const std::vector<Eigen::Vector2d>& pts, int degree);
 
 /// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held in fits), a root vertex, and the
 /// two edges where the walls leave the top at u_left < root.u < u_right (m).

@@ -1,0 +1,64 @@
+#pragma once
+// What the steps of detect_robust after the candidates share (internal): one detection's
+// inputs and look-up structures, and the steps one file calls in another. Frames and units as
+// in groovetrace/robust.hpp: the cloud's frame, metres.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "core/neighbor_grid.hpp"
+#include "robust/bins.hpp"
+#include "robust/stages.hpp"
+
+namespace groovetrace::robust_detail {
+
+/// One detection's inputs and look-up structures, built once by detect_robust.
+struct Context {
+  const Cloud& cloud;
+  const RobustParams& params;
+  const CreaseMap& map;
+  NeighborGrid voxel_grid;  ///< the map's voxel centroids, cells of params.scale
+  BoxBins bins;             ///< the cloud's points, for the sections' balls
+  double half_window;       ///< half-width of a cross-section's window (m)
+};
+
+// --- surface.cpp ----------------------------------------------------------------------------
+
+/// `tangent` (unit) laid into the top surface at p, whose normal is taken from the voxels beside
+/// the groove; `normal` is the fallback and orientation of that normal.
+Eigen::Vector3d surface_tangent(const Context& ctx, const Eigen::Vector3d& p,
+                                const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal);
+
+/// Whether the surface with `normal` at p is seen at a slant from the viewpoint (where a gap in
+/// it may stand for a groove whose walls the sensor cannot see).
+bool grazing(const Context& ctx, const Eigen::Vector3d& p, const Eigen::Vector3d& normal);
+
+// --- trace.cpp ------------------------------------------------------------------------------
+
+/// Fits the section at `origin` (m) across `tangent` laid into the surface, the profile taken
+/// within `slab` (m) along it and oriented by `normal`; `scratch` holds the ball's points.
+/// `symmetric` as in fit_v_profile.
+GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
+                         const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
+                         std::vector<std::uint32_t>& scratch, bool symmetric = false);
+
+/// Traces one seam along its ordered node roots (m) with their surface normals: sections
+/// fitted at stations along it, twice, smoothed along it, and its ends extended and trimmed.
+SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordered,
+                         std::vector<Eigen::Vector3d> normals, bool closed);
+
+// --- section_smoothing.cpp ------------------------------------------------------------------
+
+/// The sections `raw` fitted at the stations of `curve`, smoothed along the seam over the
+/// half-window `h` (m); stations without a fit within reach are dropped.
+std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw,
+                                           const SeamCurve& curve, double h);
+
+// --- merge.cpp ------------------------------------------------------------------------------
+
+/// Joins seams that are stretches of one (overlapping, touching or continuing each other
+/// across a gap of up to 3 `link`, m) and traces the joined ones again.
+void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link);
+
+}  // namespace groovetrace::robust_detail

@@ -1,0 +1,174 @@
+// Seams traced from separate node paths joined where they are one seam.
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/stats.hpp"
+#include "robust/context.hpp"
+
+namespace groovetrace::robust_detail {
+namespace {
+
+// Outward unit direction of an open seam at its end `which` (0 first, 1 last), from the roots
+// within 10 mm of it.
+Eigen::Vector3d end_direction(const SeamCandidate& s, int which) {
+  const auto& secs = s.sections;
+  const Eigen::Vector3d end = which == 0 ? secs.front().root : secs.back().root;
+  Eigen::Vector3d inner = end;
+  for (std::size_t q = 0; q < secs.size(); ++q) {
+    const auto& r = secs[which == 0 ? q : secs.size() - 1 - q].root;
+    if ((r - end).norm() > 0.01) break;
+    inner = r;
+  }
+  const Eigen::Vector3d d = end - inner;
+  return d.norm() > 1e-6 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::Zero();
+}
+
+// The gap (m) between two open seams that continue each other across it (each end points at
+// the other within 30 deg), or infinity.
+double collinear_gap(const SeamCandidate& a, const SeamCandidate& b) {
+  if (a.closed || b.closed || a.sections.size() < 2 || b.sections.size() < 2) return INFINITY;
+  double best = INFINITY;
+  for (int ea = 0; ea < 2; ++ea) {
+    for (int eb = 0; eb < 2; ++eb) {
+      const Eigen::Vector3d pa = ea == 0 ? a.sections.front().root : a.sections.back().root;
+      const Eigen::Vector3d pb = eb == 0 ? b.sections.front().root : b.sections.back().root;
+      const Eigen::Vector3d gap = pb - pa;
+      const double len = gap.norm();
+      if (!(len > 0)) return 0.0;
+      const double cos30 = 0.866;
+      if (end_direction(a, ea).dot(gap / len) > cos30 &&
+          end_direction(b, eb).dot(-gap / len) > cos30) {
+        best = std::min(best, len);
+      }
+    }
+  }
+  return best;
+}
+
+// Whether two seams look like stretches of one groove: each made of V fits (40 %), their
+// median widths within 30 % of each other. A bridge across a gap needs that; a chain of
+// shadow-edge fits beside a pipe does not have it.
+bool same_groove(const SeamCandidate& a, const SeamCandidate& b) {
+  auto stats = [](const SeamCandidate& s, double& ok, double& width) {
+    std::vector<double> w;
+    for (const auto& g : s.sections) {
+      if (g.ok) w.push_back(g.width);
+    }
+    ok = s.sections.empty() ? 0.0 : static_cast<double>(w.size()) / s.sections.size();
+    if (w.empty()) {
+      width = 0;
+      return;
+    }
+    width = upper_median(w);
+  };
+  double oka, wa, okb, wb;
+  stats(a, oka, wa);
+  stats(b, okb, wb);
+  return oka >= 0.4 && okb >= 0.4 && wa > 0 && wb > 0 &&
+         std::abs(wa - wb) <= 0.3 * std::max(wa, wb);
+}
+
+// The indices of b's sections away from a (none of a's roots within half a `link`, m), when
+// they are one run of at least two; empty otherwise.
+std::vector<std::size_t> rest_of(const SeamCandidate& a, const SeamCandidate& b, double link) {
+  std::vector<std::size_t> rest;
+  for (std::size_t k = 0; k < b.sections.size(); ++k) {
+    bool overlaps = false;
+    for (const auto& s : a.sections) {
+      if ((s.root - b.sections[k].root).norm() < 0.5 * link) {
+        overlaps = true;
+        break;
+      }
+    }
+    if (!overlaps) rest.push_back(k);
+  }
+  if (rest.size() < 2 || rest.back() - rest.front() + 1 != rest.size()) return {};
+  return rest;
+}
+
+// The facing pair of ends, a's `end_a` and the run's `end_b` (0 first, 1 last), and the
+// distance between them (m).
+double facing_ends(const SeamCandidate& a, const SeamCandidate& b,
+                   const std::vector<std::size_t>& rest, int& end_a, int& end_b) {
+  double best = INFINITY;
+  for (int ea = 0; ea < 2; ++ea) {
+    for (int eb = 0; eb < 2; ++eb) {
+      const Eigen::Vector3d pa = ea == 0 ? a.sections.front().root : a.sections.back().root;
+      const Eigen::Vector3d pb =
+          (eb == 0 ? b.sections[rest.front()] : b.sections[rest.back()]).root;
+      const double d = (pa - pb).norm();
+      if (d < best) {
+        best = d;
+        end_a = ea;
+        end_b = eb;
+      }
+    }
+  }
+  return best;
+}
+
+// a and b's run joined end to end at the facing ends, as roots (m) and top normals.
+void joined_nodes(const SeamCandidate& a, const SeamCandidate& b,
+                  const std::vector<std::size_t>& rest, int end_a, int end_b,
+                  std::vector<Eigen::Vector3d>& ordered, std::vector<Eigen::Vector3d>& normals) {
+  for (std::size_t q = 0; q < a.sections.size(); ++q) {
+    const auto& s = a.sections[end_a == 1 ? q : a.sections.size() - 1 - q];
+    ordered.push_back(s.root);
+    normals.push_back(s.normal);
+  }
+  for (std::size_t q = 0; q < rest.size(); ++q) {
+    const auto& s = b.sections[end_b == 0 ? rest[q] : rest[rest.size() - 1 - q]];
+    ordered.push_back(s.root);
+    normals.push_back(s.normal);
+  }
+}
+
+// a and b traced again as one seam (`joined`) when they are stretches of one: b's run away
+// from a touches an end of a (within `link`, m) or, untrimmed, continues it across a gap of up
+// to 3 links as the same groove. False otherwise or when the joined trace fails.
+bool join_seams(const Context& ctx, const SeamCandidate& a, const SeamCandidate& b, double link,
+                SeamCandidate& joined) {
+  if (a.sections.size() < 2 || b.sections.size() < 2) return false;
+  const std::vector<std::size_t> rest = rest_of(a, b, link);
+  if (rest.empty()) return false;
+  const bool trimmed = rest.size() < b.sections.size();
+  int end_a = 0, end_b = 0;
+  bool join = facing_ends(a, b, rest, end_a, end_b) <= link;
+  if (!join && !trimmed) join = collinear_gap(a, b) <= 3 * link && same_groove(a, b);
+  if (!join) return false;
+  std::vector<Eigen::Vector3d> ordered, normals;
+  joined_nodes(a, b, rest, end_a, end_b, ordered, normals);
+  joined = trace_seam(ctx, ordered, normals, false);
+  return joined.sections.size() >= 2;
+}
+
+}  // namespace
+
+// Seams traced from separate node paths can be one: the tracking of one runs into the other,
+// or both stop short of a corner or of a noisy stretch. The second seam's sections that
+// overlap the first are dropped; when the rest is one run whose end faces an end of the
+// first (touching, or continuing it across a gap of up to 3 links), the two are joined end
+// to end and traced again. Joining end to end, rather than re-ordering both sets of roots,
+// cannot fold the path back over itself.
+void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link) {
+  for (int round = 0; round < 8; ++round) {
+    bool merged = false;
+    for (std::size_t i = 0; i < seams.size() && !merged; ++i) {
+      for (std::size_t j = 0; j < seams.size() && !merged; ++j) {
+        if (i == j || seams[i].closed || seams[j].closed) continue;
+        SeamCandidate joined;
+        if (!join_seams(ctx, seams[i], seams[j], link, joined)) continue;
+        const std::size_t hi = std::max(i, j), lo = std::min(i, j);
+        seams.erase(seams.begin() + static_cast<std::ptrdiff_t>(hi));
+        seams.erase(seams.begin() + static_cast<std::ptrdiff_t>(lo));
+        seams.push_back(std::move(joined));
+        merged = true;
+      }
+    }
+    if (!merged) break;
+  }
+}
+
+}  // namespace groovetrace::robust_detail

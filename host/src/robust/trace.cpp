@@ -1,0 +1,420 @@
+// A seam traced from its ordered nodes: sections fitted at stations along its curve, checked
+// against each other, smoothed, extended past the ends by tracking, fitted a second time along
+// the first pass's roots, and trimmed where the groove ends.
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/stats.hpp"
+#include "robust/context.hpp"
+#include "robust/stations.hpp"
+
+namespace groovetrace::robust_detail {
+
+GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
+                         const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
+                         std::vector<std::uint32_t>& scratch, bool symmetric) {
+  const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
+  // The ball holds the window across, the slab along and the groove's depth below.
+  const double radius = 1.3 * ctx.half_window + slab;
+  ctx.bins.within(ctx.cloud, origin, radius, scratch);
+  return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window, symmetric);
+}
+
+namespace {
+
+// Arc-length distance between stations a and b (wrapping on rings).
+double arc_distance(double a, double b, double length, bool closed) {
+  double d = std::abs(a - b);
+  if (closed) d = std::min(d, length - d);
+  return d;
+}
+
+// The median width and depth (m) of the sections whose own V fit passed, and how many passed.
+struct OkMedians {
+  std::size_t count = 0;
+  double width = NAN, depth = NAN;
+};
+
+OkMedians ok_medians(const std::vector<GrooveSection>& secs) {
+  std::vector<double> widths, depths;
+  for (const auto& s : secs) {
+    if (!s.ok) continue;
+    widths.push_back(s.width);
+    depths.push_back(s.depth);
+  }
+  OkMedians med;
+  med.count = widths.size();
+  med.width = upper_median(std::move(widths));
+  med.depth = upper_median(std::move(depths));
+  return med;
+}
+
+// Where the V is not seen its opening may still show as a gap of the seam's width in the top
+// surface (walls at a grazing angle): the gap section at `origin` across `tangent` laid into
+// the surface, its root the seam's median depth below the gap.
+GrooveSection gap_section_at(const Context& ctx, const Eigen::Vector3d& origin,
+                             const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal,
+                             const OkMedians& med, std::vector<std::uint32_t>& scratch) {
+  ctx.bins.within(ctx.cloud, origin, 1.3 * ctx.half_window + ctx.params.slab, scratch);
+  return fit_gap_section(ctx.cloud, scratch, origin, surface_tangent(ctx, origin, tangent, normal),
+                         normal, ctx.params.slab, ctx.half_window, med.width, med.depth);
+}
+
+// The index of the point of `points` nearest to p (the first of equals).
+std::size_t nearest(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& p) {
+  std::size_t best = 0;
+  double best_d = INFINITY;
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    const double d = (points[j] - p).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = j;
+    }
+  }
+  return best;
+}
+
+// Stations along `curve`, each fitted; normals from the nearest of `hint_points`. `symmetric`:
+// fit symmetric V's (see fit_v_profile). Where the V failed, a gap of the seam's width seen at a
+// slant stands in (the same test the tracking uses, with this pass's median width and depth).
+std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& curve,
+                                        const std::vector<Eigen::Vector3d>& hint_points,
+                                        const std::vector<Eigen::Vector3d>& hint_normals,
+                                        bool symmetric) {
+  const std::size_t m = curve.points.size();
+  std::vector<GrooveSection> secs(m);
+  const std::int64_t count = static_cast<std::int64_t>(m);
+#pragma omp parallel
+  {
+    std::vector<std::uint32_t> scratch;
+#pragma omp for schedule(dynamic, 4)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::size_t best = nearest(hint_points, curve.points[k]);
+      secs[k] = section_at(ctx, curve.points[k], curve.tangents[k], hint_normals[best],
+                           ctx.params.slab, scratch, symmetric);
+      secs[k].s = curve.s[k];
+    }
+  }
+  const OkMedians med = ok_medians(secs);
+  std::vector<std::uint32_t> scratch;
+  for (std::size_t k = 0; k < m && med.count >= 3; ++k) {
+    if (secs[k].ok) continue;
+    const Eigen::Vector3d n = secs[k].normal.allFinite() ? secs[k].normal : hint_normals[0];
+    GrooveSection g = gap_section_at(ctx, curve.points[k], curve.tangents[k], n, med, scratch);
+    if (!g.inferred || !grazing(ctx, g.root, n) ||
+        (g.root - curve.points[k]).norm() > 0.3 * ctx.params.scale) {
+      continue;
+    }
+    g.s = secs[k].s;
+    secs[k] = g;
+  }
+  // Near a corner the window holds the other leg too: those fits are not trusted.
+  for (auto& s : secs) {
+    for (double c : curve.corners) {
+      if (arc_distance(s.s, c, curve.length, curve.closed) < ctx.half_window * 0.6) {
+        s.ok = s.inferred = false;
+        s.why = "near a corner";
+      }
+    }
+  }
+  return secs;
+}
+
+// Where an open seam continues `steps` stations past the last of `secs`: a line in arc length
+// through the ok roots within 1.5 scale (15 mm) of arc back from the end, continued (over a few
+// millimetres a seam's bend is far below the tolerances of off_track), and its direction.
+// False with fewer than four such roots or a degenerate line.
+bool continue_seam(const Context& ctx, const std::vector<GrooveSection>& secs, int steps,
+                   Eigen::Vector3d& at, Eigen::Vector3d& tangent) {
+  const double scale = ctx.params.scale;
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<double> s;
+  double arc = 0;
+  for (std::size_t k = secs.size(); k-- > 0;) {
+    if (k + 1 < secs.size()) arc += (secs[k + 1].root - secs[k].root).norm();
+    if (arc > 1.5 * scale) break;
+    if (!secs[k].ok && !secs[k].inferred) continue;
+    pts.push_back(secs[k].root);
+    s.push_back(-arc);
+  }
+  if (pts.size() < 4) return false;
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> B = Eigen::Matrix<double, 2, 3>::Zero();
+  for (std::size_t q = 0; q < pts.size(); ++q) {
+    const Eigen::Vector2d b(1, s[q] / scale);
+    A += b * b.transpose();
+    B += b * pts[q].transpose();
+  }
+  const Eigen::Matrix<double, 2, 3> C = A.ldlt().solve(B);
+  const double d = steps * ctx.params.station / scale;
+  at = (C.row(0) + d * C.row(1)).transpose();
+  tangent = C.row(1).transpose().normalized();
+  return at.allFinite() && tangent.allFinite();
+}
+
+// Whether a section tracked at `at` lies off the seam (another feature). Across the seam the
+// track must hold (3 mm). In depth a one-wall fit is looser (6 mm: its root is where the seen
+// wall meets the axis of a V taken symmetric); a two-wall V must hold 3 mm too: past a part's
+// end, a slab half on the groove and half on the end face still fits a V, its root millimetres
+// down the end face (2 mm also cut off true fits on a far, tilted 640x480 S-curve). A gap
+// carries no depth of its own (its root is placed): it must continue the surface (2 mm, a
+// normal within 20 deg of the seam's last, `normal`) or it may walk off along a shadow.
+bool off_track(const Context& ctx, const GrooveSection& sec, const Eigen::Vector3d& at,
+               const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d off = sec.root - at;
+  const double across_tol = (sec.inferred ? 0.2 : 0.3) * ctx.params.scale;
+  const double depth_tol = (sec.ok && sec.one_wall ? 0.6 : sec.ok ? 0.3 : 0.2) * ctx.params.scale;
+  const bool turned = sec.inferred && sec.normal.dot(normal) < std::cos(deg_to_rad(20.0));
+  return std::abs(off.dot(sec.across())) > across_tol ||
+         std::abs(off.dot(sec.normal)) > depth_tol || turned;
+}
+
+// The section tracked at `at` across `tangent` (`normal`: the seam's last section's): a V, or
+// where none fits a gap of the seam's width seen at a slant; neither when off the track.
+GrooveSection section_ahead(const Context& ctx, const OkMedians& med, const Eigen::Vector3d& at,
+                            const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal) {
+  std::vector<std::uint32_t> scratch;
+  GrooveSection sec = section_at(ctx, at, tangent, normal, ctx.params.slab, scratch);
+  if (!sec.ok) {
+    sec = gap_section_at(ctx, at, tangent, normal, med, scratch);
+    if (sec.inferred && !grazing(ctx, sec.root, normal)) {
+      sec.inferred = false;
+      sec.why = "a gap seen square on";
+    }
+  }
+  if ((sec.ok || sec.inferred) && off_track(ctx, sec, at, normal)) {
+    sec.ok = sec.inferred = false;
+    sec.why = "off the tracked seam";
+  }
+  return sec;
+}
+
+// Extends `secs` past its last section by tracking (see extend_ends): trailing stations whose
+// own fit failed are dropped first; misses are kept only if a later fit passes.
+void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSection>& secs) {
+  const double reach = 10 * ctx.params.scale;  // at most 100 mm more per end
+  while (!secs.empty() && !secs.back().ok && !secs.back().inferred) secs.pop_back();
+  std::vector<GrooveSection> pending;
+  int misses = 0;
+  for (double grown = 0; grown < reach; grown += ctx.params.station) {
+    Eigen::Vector3d at, tangent;
+    if (!continue_seam(ctx, secs, misses + 1, at, tangent)) break;
+    const Eigen::Vector3d normal = secs.back().normal;
+    GrooveSection sec = section_ahead(ctx, med, at, tangent, normal);
+    if (sec.ok || sec.inferred) {
+      secs.insert(secs.end(), pending.begin(), pending.end());
+      pending.clear();
+      secs.push_back(sec);
+      misses = 0;
+    } else {
+      sec.root = at;
+      sec.tangent = tangent;
+      sec.normal = normal;
+      pending.push_back(sec);
+      if (++misses >= 2) break;
+    }
+  }
+}
+
+// Extends an open seam past its ends by tracking: from the last ok sections, step one station
+// along the seam as the line through its last roots continues, fit a section there, repeat
+// while fits pass (two misses in a row end it). The crease nodes stop short where the groove
+// is seen at a grazing angle (a pipe's flanks) yet a section across the expected place still
+// finds the V.
+void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
+  const OkMedians med = ok_medians(secs);
+  if (med.count == 0) return;
+  extend_back(ctx, med, secs);
+  std::reverse(secs.begin(), secs.end());
+  extend_back(ctx, med, secs);
+  std::reverse(secs.begin(), secs.end());
+}
+
+// A groove keeps its width and depth along a seam; a V fit far off the seam's medians over
+// all its fits (narrower than 0.6 or wider than 1.6 times, shallower than 0.6 or deeper than
+// 1.5 times) caught something else - a shadow's edge, the table through a dropout - and is
+// not trusted.
+void reject_inconsistent(std::vector<GrooveSection>& secs) {
+  const OkMedians med = ok_medians(secs);
+  if (med.count < 5) return;
+  for (auto& s : secs) {
+    if (!s.ok) continue;
+    if (s.width < 0.6 * med.width || s.width > 1.6 * med.width || s.depth < 0.6 * med.depth ||
+        s.depth > 1.5 * med.depth) {
+      s.ok = false;
+      s.why = "inconsistent with the seam";
+    }
+  }
+}
+
+// A one-wall section's root (where the unseen wall would meet the seen one) is sensitive to
+// where the unseen rim is guessed; its depth is not. Where the seam has two-wall sections,
+// one-wall roots are put the seam's median depth below their opening's centre, along the
+// section's top normal.
+void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
+  std::vector<double> depths;
+  for (const auto& s : secs) {
+    if (s.ok && !s.one_wall) depths.push_back(s.depth);
+  }
+  if (depths.size() < 3) return;
+  const double depth = upper_median(depths);
+  for (auto& s : secs) {
+    if (!s.ok || !s.one_wall) continue;
+    const Eigen::Vector3d centre = 0.5 * (s.edge_left + s.edge_right);
+    s.root = centre - depth * s.normal;
+    s.depth = depth;
+  }
+}
+
+// The wall bisector, per section, is the top normal turned about the tangent by the groove's
+// asymmetry; the top normal comes from the wide top surfaces and is 2-3 times less noisy
+// than the steep, often half-hidden walls. The asymmetry is a property of the seam: its
+// median over the two-wall sections. Below kSymmetricDeg the groove is taken as symmetric
+// (what a D415 at a slant reads as asymmetry stays below that on symmetric V-grooves); above,
+// each section's bisector is the top normal turned by the median.
+constexpr double kSymmetricDeg = 8.0;
+
+// The seam's asymmetry (rad, about the tangent, from top normal to bisector): the median over
+// its two-wall sections; NaN with fewer than three.
+double seam_asymmetry(const std::vector<GrooveSection>& secs) {
+  std::vector<double> asym;
+  for (const auto& s : secs) {
+    if (!s.ok || s.one_wall) continue;
+    asym.push_back(std::atan2(s.normal.cross(s.bisector).dot(s.tangent), s.normal.dot(s.bisector)));
+  }
+  if (asym.size() < 3) return NAN;
+  return upper_median(asym);
+}
+
+bool symmetric_seam(const std::vector<GrooveSection>& secs) {
+  return std::abs(seam_asymmetry(secs)) < deg_to_rad(kSymmetricDeg);  // false for NaN
+}
+
+void align_bisectors(std::vector<GrooveSection>& secs) {
+  double turn = seam_asymmetry(secs);
+  if (std::isnan(turn)) return;
+  if (std::abs(turn) < deg_to_rad(kSymmetricDeg)) turn = 0.0;
+  for (auto& s : secs) {
+    if (!s.ok && !s.inferred) continue;
+    s.bisector = Eigen::AngleAxisd(turn, s.tangent.normalized()) * s.normal;
+  }
+}
+
+// Where smoothing dropped a long stretch (nothing fitted within reach), the curve across it is
+// a guess: keeps the run between holes longer than `link` (m) that holds the most ok sections
+// (the longer of equals).
+void keep_best_run(std::vector<GrooveSection>& secs, double link) {
+  std::size_t best_lo = 0, best_hi = 0, best_ok = 0, lo = 0;
+  for (std::size_t k = 1; k <= secs.size(); ++k) {
+    if (k < secs.size() && (secs[k].root - secs[k - 1].root).norm() <= link) continue;
+    std::size_t ok = 0;
+    for (std::size_t q = lo; q < k; ++q) ok += secs[q].ok ? 1 : 0;
+    if (ok > best_ok || (ok == best_ok && k - lo > best_hi - best_lo)) {
+      best_ok = ok;
+      best_lo = lo;
+      best_hi = k;
+    }
+    lo = k;
+  }
+  if (best_hi - best_lo < secs.size()) {
+    secs = std::vector<GrooveSection>(secs.begin() + static_cast<std::ptrdiff_t>(best_lo),
+                                      secs.begin() + static_cast<std::ptrdiff_t>(best_hi));
+  }
+}
+
+// An open seam ends where its groove leaves the part or the view; the last sections there
+// straddle the part's end face or the table. From each end, sections are dropped while their
+// own fit failed (gap-inferred ones stay: a pipe's flanks) or gave a width far from the seam's
+// median. Before that, the seam is cut at holes longer than `link` (m).
+void trim_ends(SeamCandidate& seam, double link) {
+  auto& secs = seam.sections;
+  keep_best_run(secs, link);
+  const OkMedians med = ok_medians(secs);
+  if (med.count < 3) return;
+  auto bad = [&](const GrooveSection& s) {
+    if (s.inferred) return false;
+    return !s.ok || s.width > 1.4 * med.width || s.width < 0.6 * med.width;
+  };
+  std::size_t lo = 0, hi = secs.size();
+  while (lo < hi && bad(secs[lo])) ++lo;
+  while (hi > lo && bad(secs[hi - 1])) --hi;
+  if (hi - lo < 2) return;
+  secs = std::vector<GrooveSection>(secs.begin() + static_cast<std::ptrdiff_t>(lo),
+                                    secs.begin() + static_cast<std::ptrdiff_t>(hi));
+}
+
+// The seam's length, arc lengths and corners measured along its smoothed roots (for the score
+// and the region): each corner moves to the station nearest its old arc length.
+void measure_along_roots(SeamCandidate& seam, bool closed) {
+  std::vector<double> old_s, new_s;
+  double s = 0;
+  for (std::size_t k = 0; k < seam.sections.size(); ++k) {
+    if (k > 0) s += (seam.sections[k].root - seam.sections[k - 1].root).norm();
+    old_s.push_back(seam.sections[k].s);
+    new_s.push_back(s);
+    seam.sections[k].s = s;
+  }
+  if (closed) s += (seam.sections.front().root - seam.sections.back().root).norm();
+  std::vector<double> corners;
+  for (double c : seam.curve.corners) {
+    std::size_t best = 0;
+    for (std::size_t k = 0; k < old_s.size(); ++k) {
+      if (std::abs(old_s[k] - c) < std::abs(old_s[best] - c)) best = k;
+    }
+    corners.push_back(new_s[best]);
+  }
+  seam.curve.corners = corners;
+  seam.curve.length = s;
+  seam.curve.closed = closed;
+}
+
+}  // namespace
+
+SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordered,
+                         std::vector<Eigen::Vector3d> normals, bool closed) {
+  SeamCandidate seam;
+  const RobustParams& p = ctx.params;
+  // A symmetric seam (the first pass's walls dip alike, within kSymmetricDeg) is fitted with
+  // symmetric V's the second time: at a slant one wall is seen at a grazing angle, a pixel's
+  // footprint on it stretches to 2-4 mm, and its slope from the two or three image rows it
+  // gets (one of them blurred into the root by stereo matching) comes out several degrees too
+  // flat, which moves its rim out and the root towards the other wall by up to a millimetre.
+  bool symmetric = false;
+  for (int pass = 0; pass < 2; ++pass) {
+    // Sampled finely, then at stations anchored to the frame (robust/stations.hpp).
+    const SeamCurve curve = anchored_stations(
+        smooth_curve(ordered, closed, p.smooth, 0.25 * p.station, normals), p.station);
+    if (curve.points.size() < 2) break;
+    std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, symmetric);
+    reject_inconsistent(raw);
+    if (pass == 0) symmetric = symmetric_seam(raw);
+    anchor_one_wall_roots(raw);
+    align_bisectors(raw);
+    std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);
+    if (pass == 0 && !closed) {
+      extend_ends(ctx, smooth);
+      if (smooth.size() < 2) break;
+    }
+    seam.curve = curve;
+    seam.sections = smooth;
+    seam.raw = raw;
+    if (smooth.size() < 2) break;
+    // The next pass follows this one's roots; where fits failed those are the curve's own
+    // points (a corner's legs meet where their lines do), so no gap cuts a corner short.
+    ordered.clear();
+    normals.clear();
+    for (const auto& s : smooth) {
+      ordered.push_back(s.root);
+      normals.push_back(s.normal);
+    }
+  }
+  if (!closed) trim_ends(seam, 1.5 * p.scale);
+  if (seam.sections.size() >= 2) measure_along_roots(seam, closed);
+  seam.closed = closed;
+  return seam;
+}
+
+}  // namespace groovetrace::robust_detail

@@ -1,0 +1,653 @@
+// Stage 2 of the robust method: the V model fitted to one cross-section of the seam.
+//
+// The profile is (u across, v height): top surface, two walls. The top is fitted first, from
+// the outer half of the window where no groove lies, as a robust quadratic (a pipe's crown
+// bends 2-4 mm over a 20 mm window). Points clearly below it are the groove; from their run a
+// first V (root at the deepest points, edges at the run's ends) is refined as a whole - root,
+// both edges, the top's offset and slope - on the points' orthogonal distances (walls are
+// steep, so residuals in v alone would weigh them wrongly). The rims and the root are left out
+// of the fit: stereo matching rounds both off, and the root gap is not a wall. Root = the
+// walls' intersection, edges = walls meet top.
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/stats.hpp"
+#include "robust/stages.hpp"
+#include "robust/vmodel.hpp"
+
+namespace groovetrace {
+namespace {
+
+using robust_detail::fit_poly;
+using robust_detail::kLeftU;
+using robust_detail::kQ0;
+using robust_detail::kQ1;
+using robust_detail::kRightU;
+using robust_detail::kRootU;
+using robust_detail::kRootV;
+using robust_detail::nearest_piece;
+using robust_detail::top_at;
+using robust_detail::Vec6;
+using robust_detail::VModel;
+
+// Robust sigma of residuals: the rms of the smallest 80% of |r|, scaled to a Gaussian's sigma
+// (0.6616 sigma for a Gaussian). Unlike the MAD it does not collapse to zero on depths
+// quantized to 1 mm, where most of a flat's points share one value.
+double robust_sigma(const std::vector<double>& r) {
+  if (r.empty()) return 0.0;
+  std::vector<double> a(r.size());
+  for (std::size_t k = 0; k < r.size(); ++k) a[k] = r[k] * r[k];
+  const std::size_t keep = std::max<std::size_t>(1, (r.size() * 8) / 10);
+  std::nth_element(a.begin(), a.begin() + (keep - 1), a.end());
+  double ss = 0;
+  for (std::size_t k = 0; k < keep; ++k) ss += a[k];
+  return std::sqrt(ss / keep) / 0.6616;
+}
+
+}  // namespace
+
+// Iteratively reweighted least squares, six rounds, each weighting by the last one's residuals.
+std::pair<Eigen::Vector3d, double> robust_detail::fit_poly(const std::vector<Eigen::Vector2d>& pts,
+                                                           int degree) {
+  const int m = degree + 1;
+  std::vector<double> w(pts.size(), 1.0);
+  Eigen::Vector3d q = Eigen::Vector3d::Zero();
+  double sigma = 0;
+  for (int iter = 0; iter < 6; ++iter) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double u = pts[k].x();
+      const Eigen::Vector3d row(1, u, u * u);
+      A.topLeftCorner(m, m) += w[k] * row.head(m) * row.head(m).transpose();
+      b.head(m) += w[k] * pts[k].y() * row.head(m);
+    }
+    Eigen::Vector3d sol = Eigen::Vector3d::Zero();
+    sol.head(m) = A.topLeftCorner(m, m).ldlt().solve(b.head(m));
+    if (!sol.allFinite()) break;
+    q = sol;
+    std::vector<double> r(pts.size());
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double u = pts[k].x();
+      r[k] = pts[k].y() - (q[0] + q[1] * u + q[2] * u * u);
+    }
+    sigma = robust_sigma(r);
+    for (std::size_t k = 0; k < r.size(); ++k)
+      w[k] = tukey_weight_or_one(r[k], kTukeyC * std::max(sigma, 1e-7));
+  }
+  return {q, sigma};
+}
+
+namespace {
+
+// Angle (deg) by which `wall` (unit, from the edge towards the root) dips below the top's
+// tangent `inward` (unit, along the top towards the groove). Positive: into the material.
+double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool left) {
+  const double cross = inward.x() * wall.y() - inward.y() * wall.x();
+  return rad_to_deg(std::atan2(left ? -cross : cross, inward.dot(wall)));
+}
+
+bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
+  const double z2 = zone * zone;
+  return (p - m.root).squaredNorm() < z2 || (p - m.edge_left()).squaredNorm() < z2 ||
+         (p - m.edge_right()).squaredNorm() < z2;
+}
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// The V's parameters as the Gauss-Newton fit moves them. Free: x = (root u, root v, u_left,
+// u_right, q0, q1). Symmetric: x[2] is the half width h and x[3] is unused (held at 0); the
+// edges lie at u_c -+ h, u_c the foot of the top normal through the root (on the top's tangent
+// line there), so both walls dip alike. The top's curvature q2 is held at the start's.
+struct VParams {
+  VModel start;
+  bool symmetric;
+
+  // u_c, with s the top's slope at the root and g its height above the root:
+  // u_c = root u - s g / (1 + s^2).
+  double centre_u(const Vec6& x) const {
+    const double s = x[5] + 2 * start.q[2] * x[0];
+    const double gap = x[4] + x[5] * x[0] + start.q[2] * x[0] * x[0] - x[1];
+    return x[0] - s * gap / (1 + s * s);
+  }
+
+  Vec6 pack(const VModel& v) const {
+    Vec6 x;
+    x << v.root.x(), v.root.y(), v.u_left, v.u_right, v.q[0], v.q[1];
+    if (symmetric) {
+      x[2] = 0.5 * (v.u_right - v.u_left);
+      x[3] = 0;
+    }
+    return x;
+  }
+
+  VModel unpack(const Vec6& x) const {
+    VModel v = start;
+    v.root = {x[0], x[1]};
+    v.u_left = x[2];
+    v.u_right = x[3];
+    v.q[0] = x[4];
+    v.q[1] = x[5];
+    if (symmetric) {
+      const double uc = centre_u(x);
+      v.u_left = uc - x[2];
+      v.u_right = uc + x[2];
+    }
+    return v;
+  }
+
+  // d(free parameters) / d(x), for the chain rule: the identity when free.
+  Mat6 chain(const Vec6& x) const {
+    Mat6 M = Mat6::Identity();
+    if (!symmetric) return M;
+    const double s = x[5] + 2 * start.q[2] * x[0];
+    const double g = x[4] + x[5] * x[0] + start.q[2] * x[0] * x[0] - x[1];
+    const double n = 1 + s * s;
+    const double df_ds = g * (1 - s * s) / (n * n), df_dg = s / n;
+    Vec6 du = Vec6::Zero();  // d u_c / d x
+    du[0] = 1 - (df_ds * 2 * start.q[2] + df_dg * s);
+    du[1] = df_dg;
+    du[4] = -df_dg;
+    du[5] = -(df_ds + df_dg * x[0]);
+    M.setZero();
+    M(kRootU, 0) = 1;
+    M(kRootV, 1) = 1;
+    M(kQ0, 4) = 1;
+    M(kQ1, 5) = 1;
+    M.row(kLeftU) = du.transpose();
+    M.row(kRightU) = du.transpose();
+    M(kLeftU, 2) -= 1;
+    M(kRightU, 2) += 1;
+    return M;
+  }
+};
+
+// The robust cost of `v`: Tukey's rho of each point's distance at scale c (normalised to 1 at
+// and beyond c), the points near the three vertices left out.
+double tukey_cost(const std::vector<Eigen::Vector2d>& pts, const VModel& v, double c, double zone) {
+  double sum = 0;
+  for (const auto& p : pts) {
+    if (near_vertex(p, v, zone)) continue;
+    const double r = nearest_piece(p, v).second / c;
+    const double a = 1 - r * r;
+    sum += std::abs(r) >= 1 ? 1.0 : 1 - a * a * a;
+  }
+  return sum;
+}
+
+// The damped Gauss-Newton step from x, Tukey-weighted at scale c.
+Vec6 gauss_newton_step(const std::vector<Eigen::Vector2d>& pts, const VParams& par, const Vec6& x,
+                       double c, double zone) {
+  const VModel cur = par.unpack(x);
+  const Mat6 M = par.chain(x);
+  Mat6 JtJ = Mat6::Zero();
+  Vec6 Jtr = Vec6::Zero();
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    if (near_vertex(pts[k], cur, zone)) continue;
+    Vec6 J;
+    const double r = nearest_piece(pts[k], cur, &J).second;
+    J = (M.transpose() * J).eval();
+    const double w = tukey_weight_or_one(r, c);
+    if (w <= 0) continue;
+    JtJ += w * J * J.transpose();
+    Jtr += w * J * r;
+  }
+  // Marquardt damping, relative to each parameter's own curvature (the slope q1 is
+  // dimensionless, the rest metres: a damping shared by all would freeze the slope), plus a
+  // floor that keeps unconstrained directions (a wall without points) still.
+  const double floor = 1e-9 * JtJ.diagonal().maxCoeff() + 1e-12;
+  JtJ.diagonal() = JtJ.diagonal() * (1 + 1e-3) + Vec6::Constant(floor);
+  return -JtJ.ldlt().solve(Jtr);
+}
+
+// Gauss-Newton steps at Tukey scale c, each halved until the cost drops (the edges staying on
+// either side of the root), until a step no longer gains. False when a step is not finite.
+bool descend(const std::vector<Eigen::Vector2d>& pts, const VParams& par, double c, double zone,
+             Vec6& x) {
+  double f = tukey_cost(pts, par.unpack(x), c, zone);
+  for (int iter = 0; iter < 30; ++iter) {
+    const Vec6 step = gauss_newton_step(pts, par, x, c, zone);
+    if (!step.allFinite()) return false;
+    double t = 1.0;
+    bool improved = false;
+    for (int half = 0; half < 8; ++half, t *= 0.5) {
+      const Vec6 xn = x + t * step;
+      const VModel vn = par.unpack(xn);
+      if (!(vn.u_left < vn.root.x() && vn.root.x() < vn.u_right)) continue;
+      const double fn = tukey_cost(pts, vn, c, zone);
+      if (fn < f) {
+        x = xn;
+        improved = f - fn > 1e-6 * (1 + f);
+        f = fn;
+        break;
+      }
+    }
+    if (!improved || (t * step).norm() < 1e-6) break;
+  }
+  return true;
+}
+
+// Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with analytic derivatives and
+// Tukey weights from the current residuals (at scale `scale`, m), the points within `zone` (m)
+// of a vertex left out; `symmetric` as in VParams. False, `m` untouched, when it diverges.
+bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, double zone,
+              double coarse, bool symmetric) {
+  const VParams par{m, symmetric};
+  Vec6 x = par.pack(m);
+  // Graduated: a wide Tukey window first (`coarse`, m), so that a start a few millimetres off
+  // still sees the walls, then halving down to the noise.
+  for (double stage = std::max(coarse, scale);; stage = std::max(scale, 0.5 * stage)) {
+    if (!descend(pts, par, kTukeyC * stage, zone, x)) return false;
+    if (stage <= scale) break;
+  }
+  m = par.unpack(x);
+  return m.root.allFinite() && std::isfinite(m.u_left) && std::isfinite(m.u_right);
+}
+
+// First crossing of the ray from `from` along unit `dir` with v = q0 + q1 u + q2 u^2.
+bool meet_top(const Eigen::Vector2d& from, const Eigen::Vector2d& dir, const Eigen::Vector3d& q,
+              Eigen::Vector2d& out) {
+  // f(t) = top(u(t)) - v(t) = A t^2 + B t + C; the first root t > 0.
+  const double u = from.x(), v = from.y(), du = dir.x(), dv = dir.y();
+  const double A = q[2] * du * du;
+  const double B = q[1] * du + 2 * q[2] * u * du - dv;
+  const double C = q[0] + q[1] * u + q[2] * u * u - v;
+  double t = NAN;
+  if (std::abs(A) < 1e-12) {
+    if (std::abs(B) > 1e-12) t = -C / B;
+  } else {
+    const double disc = B * B - 4 * A * C;
+    if (disc >= 0) {
+      const double s = std::sqrt(disc);
+      const double t1 = (-B - s) / (2 * A), t2 = (-B + s) / (2 * A);
+      const double lo = std::min(t1, t2), hi = std::max(t1, t2);
+      t = lo > 0 ? lo : hi;
+    }
+  }
+  if (!(t > 0) || !std::isfinite(t)) return false;
+  out = from + t * dir;
+  return true;
+}
+
+// Orthogonal (total least squares) line through `pts`, Tukey-reweighted on the perpendicular
+// residual: returns a point on it and its unit direction.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> fit_line(const std::vector<Eigen::Vector2d>& pts,
+                                                     double scale) {
+  std::vector<double> w(pts.size(), 1.0);
+  Eigen::Vector2d c(0, 0), d(1, 0);
+  for (int iter = 0; iter < 5; ++iter) {
+    double sw = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      sw += w[k];
+      mean += w[k] * pts[k];
+    }
+    if (!(sw > 0)) break;
+    mean /= sw;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      cov += w[k] * (pts[k] - mean) * (pts[k] - mean).transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    c = mean;
+    d = eig.eigenvectors().col(1).normalized();
+    const Eigen::Vector2d nrm(-d.y(), d.x());
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      w[k] = tukey_weight_or_one((pts[k] - c).dot(nrm), kTukeyC * scale);
+  }
+  return {c, d};
+}
+
+struct PieceStats {
+  int count[4] = {0, 0, 0, 0};  // points fitting each piece (Tukey inliers)
+  double wall_rms = 0;          // rms distance of the wall inliers
+  double top_sigma = 0;         // robust sigma of the top inliers
+  double top_outliers = 0;      // share of the outer points that do not fit the top
+};
+
+PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m, double scale,
+                       double zone) {
+  PieceStats st;
+  double ss = 0;
+  int nw = 0, outer = 0, outer_bad = 0;
+  std::vector<double> top_r;
+  const double c = kTukeyC * scale;
+  for (const auto& p : pts) {
+    const auto [piece, r] = nearest_piece(p, m);
+    const bool is_top = piece == 0 || piece == 3;
+    if (is_top && (p.x() < m.u_left - zone || p.x() > m.u_right + zone)) {
+      ++outer;
+      if (std::abs(r) >= c) ++outer_bad;
+    }
+    if (near_vertex(p, m, zone) || std::abs(r) >= c) continue;
+    ++st.count[piece];
+    if (is_top) {
+      top_r.push_back(r);
+    } else {
+      ss += r * r;
+      ++nw;
+    }
+  }
+  st.wall_rms = nw > 0 ? std::sqrt(ss / nw) : 0;
+  st.top_sigma = robust_sigma(top_r);
+  st.top_outliers = outer > 0 ? static_cast<double>(outer_bad) / outer : 1.0;
+  return st;
+}
+
+// A two-wall V needs this many points on each wall; a one-wall V twice as many on its wall.
+constexpr int kMinWall = 4;
+
+// What the steps of one profile's fit share: the window's points and the scales the top
+// surface's noise sets (all in m).
+struct ProfileFit {
+  std::vector<Eigen::Vector2d> pts;    // the finite points within |u| <= W
+  std::vector<Eigen::Vector2d> outer;  // those with |u| >= W / 2, where the top lies
+  double W = 0;                        // half window
+  double sigma = 0;                    // robust sigma of the top's residuals
+  double tau = 0;                      // points within tau of the top are top
+  double scale = 0;                    // Tukey scale of the V fit
+  double vertex_zone = 0;              // points this near a vertex stay out of the fits
+  double top_step = 0;                 // height step between the two top sides' lines
+};
+
+// 1. The top surface `q` from the outer half of the window. A quadratic needs both sides; its
+//    curvature is bounded (radius >= W) so that it cannot bend into the groove. False without
+//    three points on either side.
+bool fit_top(ProfileFit& f, Eigen::Vector3d& q) {
+  int n_left = 0, n_right = 0;
+  for (const auto& p : f.pts) {
+    if (std::abs(p.x()) >= 0.5 * f.W) {
+      f.outer.push_back(p);
+      (p.x() < 0 ? n_left : n_right) += 1;
+    }
+  }
+  if (n_left < 3 && n_right < 3) return false;
+  std::pair<Eigen::Vector3d, double> top = fit_poly(f.outer, n_left >= 3 && n_right >= 3 ? 2 : 1);
+  if (std::abs(top.first[2]) > 0.5 / f.W) top = fit_poly(f.outer, 1);
+  q = top.first;
+  f.sigma = top.second;
+  // Points within tau of the top are top; tau covers the sensor noise with a floor for
+  // noise-free scans (2% of the window, 0.4 mm at the default scale).
+  f.tau = std::max(3.0 * f.sigma, 0.02 * f.W);
+  return true;
+}
+
+// 2. The groove: the run of points clearly below the top `q` that holds the deepest point near
+//    the centre (the most depth summed over a run reaching into the central half). Runs split
+//    at gaps in u (other dips, the table beyond an edge). Empty, `why` set, when none.
+std::vector<Eigen::Vector2d> groove_run(const ProfileFit& f, const Eigen::Vector3d& q,
+                                        std::string& why) {
+  std::vector<Eigen::Vector2d> below;
+  for (const auto& p : f.pts) {
+    if (p.y() - top_at(q, p.x()) < -f.tau) below.push_back(p);
+  }
+  if (below.size() < 6) {
+    why = "nothing below the top surface";
+    return {};
+  }
+  std::sort(below.begin(), below.end(),
+            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x(); });
+  const double gap = 0.15 * f.W;
+  std::size_t best_lo = 0, best_hi = 0;
+  double best_mass = -1;
+  for (std::size_t lo = 0; lo < below.size();) {
+    std::size_t hi = lo + 1;
+    while (hi < below.size() && below[hi].x() - below[hi - 1].x() <= gap) ++hi;
+    double mass = 0;
+    bool central = false;
+    for (std::size_t k = lo; k < hi; ++k) {
+      mass += top_at(q, below[k].x()) - below[k].y();
+      central = central || std::abs(below[k].x()) <= 0.5 * f.W;
+    }
+    if (central && mass > best_mass) {
+      best_mass = mass;
+      best_lo = lo;
+      best_hi = hi;
+    }
+    lo = hi;
+  }
+  if (best_mass < 0 || best_hi - best_lo < 6) {
+    why = "no groove near the centre";
+    return {};
+  }
+  return {below.begin() + best_lo, below.begin() + best_hi};
+}
+
+// 3. The initial V from the groove's run (sorted by u) under the top `q`: root at its deepest
+//    points, edges at its ends.
+VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q, double W) {
+  std::vector<double> depths, deep_u;
+  for (const auto& p : groove) depths.push_back(top_at(q, p.x()) - p.y());
+  std::vector<double> sorted_depths = depths;
+  std::sort(sorted_depths.begin(), sorted_depths.end());
+  const double d90 = sorted_depths[(sorted_depths.size() * 9) / 10];
+  for (std::size_t k = 0; k < groove.size(); ++k) {
+    if (depths[k] >= 0.8 * d90) deep_u.push_back(groove[k].x());
+  }
+  const double u0 = upper_median(deep_u);
+  VModel m;
+  m.q = q;
+  m.root = Eigen::Vector2d(u0, top_at(q, u0) - d90);
+  m.u_left = std::min(groove.front().x(), u0 - 0.1 * W);
+  m.u_right = std::max(groove.back().x(), u0 + 0.1 * W);
+  return m;
+}
+
+// Each side's top on its own, as a line from the outer half: a real groove's two top sides
+// continue each other (curved or not, their lines meet above the centre at one height); a
+// step down to a table fitted by one tilted line does not. The two lines' height difference
+// at u = 0 (m); 0 without three points on each side.
+double top_step(const std::vector<Eigen::Vector2d>& outer) {
+  std::vector<Eigen::Vector2d> lo, hi;
+  for (const auto& p : outer) (p.x() < 0 ? lo : hi).push_back(p);
+  if (lo.size() < 3 || hi.size() < 3) return 0;
+  const Eigen::Vector3d ql = fit_poly(lo, 1).first, qr = fit_poly(hi, 1).first;
+  return std::abs(ql[0] - qr[0]);
+}
+
+// The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
+// opening and bisector. `fallback_noise` (m) when the top has no inliers.
+VProfile describe_v(const VModel& v, const PieceStats& st, double fallback_noise) {
+  VProfile o;
+  const Eigen::Vector2d el = v.edge_left(), er = v.edge_right();
+  o.top = v.q;
+  o.root = v.root;
+  o.edge_left = el;
+  o.edge_right = er;
+  o.top_left = st.count[0];
+  o.wall_left = st.count[1];
+  o.wall_right = st.count[2];
+  o.top_right = st.count[3];
+  o.rms = st.wall_rms;
+  o.noise = st.top_sigma > 0 ? st.top_sigma : fallback_noise;
+  o.width = (er - el).norm();
+  o.depth = top_at(v.q, v.root.x()) - v.root.y();
+  const Eigen::Vector2d to_root_l = (v.root - el).normalized();
+  const Eigen::Vector2d to_root_r = (v.root - er).normalized();
+  const Eigen::Vector2d tl = Eigen::Vector2d(1, v.q[1] + 2 * v.q[2] * el.x()).normalized();
+  const Eigen::Vector2d tr = Eigen::Vector2d(1, v.q[1] + 2 * v.q[2] * er.x()).normalized();
+  o.wall_left_deg = dip_deg(tl, to_root_l, true);
+  o.wall_right_deg = dip_deg(-tr, to_root_r, false);
+  o.opening_deg = rad_to_deg(std::acos(std::clamp(to_root_l.dot(to_root_r), -1.0, 1.0)));
+  o.bisector = (-to_root_l - to_root_r).normalized();
+  return o;
+}
+
+// 5. Is it a V? Both walls dip into the material at a plausible angle (a vertical step to a
+//    table is ~90 deg, a convex edge negative), both top sides and both walls (`wall_min`
+//    points each) carry points, the groove lies inside the window and is deeper than the
+//    noise. Why not, or nullptr when it is.
+const char* why_not_v(const VProfile& o, const PieceStats& st, const ProfileFit& f, int wall_min) {
+  const Eigen::Vector2d &el = o.edge_left, &er = o.edge_right;
+  if (!o.root.allFinite() || !el.allFinite() || !er.allFinite()) return "V fit did not converge";
+  if (o.wall_left_deg < 8 || o.wall_right_deg < 8) return "a wall is too flat";
+  if (o.wall_left_deg > 86 || o.wall_right_deg > 86) return "a wall is vertical or overhangs";
+  if (o.top_left < 3 || o.top_right < 3) return "a top surface is missing";
+  if (o.wall_left < wall_min || o.wall_right < wall_min) return "a wall is missing";
+  if (o.depth < 1.5 * f.tau) return "too shallow for the noise";
+  if (el.x() < -0.9 * f.W || er.x() > 0.9 * f.W || el.x() >= er.x()) {
+    return "groove leaves the window";
+  }
+  if (o.rms > 0.35 * o.depth) return "walls are not straight";
+  if (st.top_outliers > 0.5) return "top surfaces disagree";
+  if (f.top_step > std::max(2 * f.tau, 0.5 * o.depth)) {
+    return "top surfaces at different heights (a step)";
+  }
+  return nullptr;
+}
+
+// The profile of the V `v` and whether it is one (see why_not_v). `one_wall`: one wall's
+// points are not required.
+VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
+  const PieceStats st = piece_stats(f.pts, v, f.scale, f.vertex_zone);
+  VProfile o = describe_v(v, st, f.sigma);
+  o.one_wall = one_wall;
+  const char* why = why_not_v(o, st, f, one_wall ? 0 : kMinWall);
+  if (why) {
+    o.why = why;
+  } else {
+    o.ok = true;
+  }
+  return o;
+}
+
+// The wall of the failed V `m` on the seen side, refitted alone (the failed fit's root may have
+// been dragged by strays): `edge` where it meets the top, `up` the unit direction up the wall
+// towards it. False with too few wall points or no crossing.
+bool seen_wall(const VModel& m, const ProfileFit& f, bool left_missing, Eigen::Vector2d& edge,
+               Eigen::Vector2d& up) {
+  std::vector<Eigen::Vector2d> wall_pts;
+  for (const auto& p : f.pts) {
+    if (near_vertex(p, m, f.vertex_zone)) continue;
+    const auto [piece, r] = nearest_piece(p, m);
+    if (piece == (left_missing ? 2 : 1) && std::abs(r) < kTukeyC * f.scale) wall_pts.push_back(p);
+  }
+  if (wall_pts.size() < static_cast<std::size_t>(2 * kMinWall)) return false;
+  const auto [wc, wd] = fit_line(wall_pts, f.scale);
+  up = (left_missing ? wd.x() > 0 : wd.x() < 0) ? wd : Eigen::Vector2d(-wd);
+  return meet_top(wc, up, m.q, edge);
+}
+
+// The unseen wall's rim, u (m): the top on that side ends there (its innermost point, plus half
+// the spacing of the top points). From the outside in, the top's run of points ends at the
+// first wide gap (the groove); points beyond it near the top's height are the seen wall's rim.
+// False with fewer than three top points on that side.
+bool unseen_rim(const Eigen::Vector3d& q, const ProfileFit& f, bool left_missing,
+                const Eigen::Vector2d& seen_edge, double& edge) {
+  std::vector<double> tops;  // distance inwards: u on the left, -u on the right
+  for (const auto& p : f.pts) {
+    if (std::abs(p.y() - top_at(q, p.x())) > f.tau) continue;
+    if (left_missing ? p.x() < seen_edge.x() - f.vertex_zone
+                     : p.x() > seen_edge.x() + f.vertex_zone) {
+      tops.push_back(left_missing ? p.x() : -p.x());
+    }
+  }
+  if (tops.size() < 3) return false;
+  std::sort(tops.begin(), tops.end());
+  std::vector<double> gaps;
+  for (std::size_t k = 1; k < tops.size(); ++k) gaps.push_back(tops[k] - tops[k - 1]);
+  const double spacing = upper_median(gaps);
+  std::size_t last = 0;
+  while (last + 1 < tops.size() &&
+         tops[last + 1] - tops[last] <= std::max(3 * spacing, 0.1 * f.W)) {
+    ++last;
+  }
+  edge = (tops[last] + 0.5 * spacing) * (left_missing ? 1 : -1);
+  return true;
+}
+
+// `one`'s opening from the unseen rim at u = `edge` to the seen wall's rim, and its root where
+// the top normal through the opening's centre meets the seen wall (running `up` to its rim).
+// False when the two are parallel or the root falls outside the opening.
+bool symmetric_root(const Eigen::Vector2d& seen_edge, const Eigen::Vector2d& up, double edge,
+                    bool left_missing, VModel& one) {
+  const Eigen::Vector3d& q = one.q;
+  const double uc = 0.5 * (edge + seen_edge.x());
+  const Eigen::Vector2d centre(uc, top_at(q, uc));
+  const Eigen::Vector2d axis = -Eigen::Vector2d(-(q[1] + 2 * q[2] * uc), 1).normalized();
+  Eigen::Matrix2d M;
+  M.col(0) = axis;
+  M.col(1) = up;
+  if (std::abs(M.determinant()) < 1e-6) return false;
+  const Eigen::Vector2d ts = M.inverse() * (seen_edge - centre);
+  one.root = centre + ts.x() * axis;
+  one.u_left = left_missing ? edge : seen_edge.x();
+  one.u_right = left_missing ? seen_edge.x() : edge;
+  return one.u_left < one.root.x() && one.root.x() < one.u_right;
+}
+
+// 6. One wall seen, the other at a grazing angle (no or a few stray points, which the two-wall
+//    fit `m` then bends into a vertical or flat wall): the unseen wall's edge is where the top
+//    surface ends, half a sample spacing past the last top point, and the V is symmetric about
+//    the top normal through the opening's centre, so the root lies where that axis meets the
+//    seen wall. `two_wall` (m's profile) when that does not apply or fails to fit.
+VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit& f) {
+  auto seen = [](int points, double dip) {
+    return points >= 2 * kMinWall && dip >= 8 && dip <= 86;
+  };
+  const bool left_seen = seen(two_wall.wall_left, two_wall.wall_left_deg);
+  const bool right_seen = seen(two_wall.wall_right, two_wall.wall_right_deg);
+  if (left_seen == right_seen) return two_wall;
+  const bool left_missing = right_seen;
+  Eigen::Vector2d seen_edge, up;
+  double edge = 0;
+  VModel one = m;
+  if (!seen_wall(m, f, left_missing, seen_edge, up) ||
+      !unseen_rim(m.q, f, left_missing, seen_edge, edge) ||
+      !symmetric_root(seen_edge, up, edge, left_missing, one)) {
+    return two_wall;
+  }
+  VProfile alt = judge_v(one, true, f);
+  if (!alt.ok) alt.why = "one wall: " + alt.why;
+  return alt;
+}
+
+}  // namespace
+
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window,
+                       bool symmetric) {
+  VProfile out;
+  ProfileFit f;
+  f.W = half_window;
+  f.pts.reserve(all.size());
+  for (const auto& p : all) {
+    if (std::abs(p.x()) <= f.W && p.allFinite()) f.pts.push_back(p);
+  }
+  if (f.pts.size() < 16) {
+    out.why = "too few points";
+    return out;
+  }
+  Eigen::Vector3d q;
+  if (!fit_top(f, q)) {
+    out.why = "no top surface";
+    return out;
+  }
+  out.top = q;
+  out.noise = f.sigma;
+  const std::vector<Eigen::Vector2d> groove = groove_run(f, q, out.why);
+  if (groove.empty()) return out;
+  VModel m = initial_v(groove, q, f.W);
+
+  // 4. Joint robust fit of the whole V (root, both edges, the top's offset and slope) to the
+  //    orthogonal distances, by Gauss-Newton with Tukey weights. Points near the three
+  //    vertices do not count: rounded rims and the root gap are not the V's planes.
+  f.scale = std::max(f.sigma, 0.005 * f.W);
+  f.vertex_zone = std::max(2 * f.sigma, 0.06 * f.W);
+  if (!refine_v(f.pts, m, f.scale, f.vertex_zone, 0.1 * f.W, false)) {
+    out.why = "V fit did not converge";
+    return out;
+  }
+  if (symmetric) {
+    VModel sym = m;
+    if (refine_v(f.pts, sym, f.scale, f.vertex_zone, 0.1 * f.W, true)) m = sym;
+  }
+  f.top_step = top_step(f.outer);
+  const VProfile two_wall = judge_v(m, false, f);
+  if (two_wall.ok) return two_wall;
+  return one_wall_v(m, two_wall, f);
+}
+
+}  // namespace groovetrace
