@@ -1,6 +1,7 @@
 #pragma once
 // Reading scans (PCD, PLY) and writing the annotated cloud.
 
+#include <groovetrace/export.hpp>
 #include <groovetrace/cloud.hpp>
 
 #include <cstdint>
@@ -24,7 +25,7 @@ struct ReadOptions {
 /// Throws InputError (one line) for: missing or unreadable file, unknown extension, a
 /// malformed or truncated file, no x/y/z fields, no points, all points NaN, fewer than
 /// min_valid_points finite points, or any infinite coordinate.
-Cloud read_cloud(const std::string& path, const ReadOptions& options = {});
+GT_API Cloud read_cloud(const std::string& path, const ReadOptions& options = {});
 
 /// Per-point annotations written beside the input points.
 struct Annotations {
@@ -37,13 +38,13 @@ struct Annotations {
 /// uint8), the points of `cloud` in its order and shape (width, height, viewpoint).
 /// Returns the file's bytes; write them with write_file_atomic. Throws InternalError when
 /// the annotation sizes do not match the cloud or width * height != size.
-std::string annotated_pcd_bytes(const Cloud& cloud, const Annotations& annotations);
+GT_API std::string annotated_pcd_bytes(const Cloud& cloud, const Annotations& annotations);
 
 /// Writes a plain XYZ binary PCD (organized if cloud is), e.g. for generated scans.
-std::string pcd_bytes(const Cloud& cloud);
+GT_API std::string pcd_bytes(const Cloud& cloud);
 
 /// Writes `bytes` to `path` completely or not at all: a temporary file in the same
 /// directory, flushed, then renamed over `path`. Throws InputError on failure.
-void write_file_atomic(const std::string& path, const std::string& bytes);
+GT_API void write_file_atomic(const std::string& path, const std::string& bytes);
 
 }  // namespace groovetrace

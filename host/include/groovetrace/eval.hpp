@@ -6,6 +6,7 @@
 // Frames: everything is compared in the scan's camera frame (metres). A trajectory written in
 // the robot base frame (`run --hand-eye ...`) cannot be compared; evaluate_files notes it.
 
+#include <groovetrace/export.hpp>
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <groovetrace/synth.hpp>
@@ -74,7 +75,7 @@ struct EvalMetrics {
 /// Metrics from in-memory data. `detected` has one entry per scan point (1 = groove), in the
 /// truth's point order; `poses` are in the camera frame, in travel order. Throws InputError if
 /// `detected` does not match the truth's point count.
-EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
+GT_API EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
                      const std::vector<ToolPose>& poses, const EvalOptions& options = {});
 
 /// What evaluate_files reads from a `groovetrace run` output directory.
@@ -91,16 +92,16 @@ struct RunOutput {
 /// Reads annotated.pcd (a PCD of any DATA kind with a `groove` field), trajectory.csv (header
 /// `idx,x_m,y_m,z_m,qx,qy,qz,qw,...`), and, when present, trajectory.json and report.json.
 /// Throws InputError when annotated.pcd is missing or malformed, or trajectory.csv malformed.
-RunOutput read_run_output(const std::string& result_dir);
+GT_API RunOutput read_run_output(const std::string& result_dir);
 
 /// Reads the truth of `scan_path` (read_synth_truth) and the run output, and evaluates.
-EvalMetrics evaluate_files(const std::string& scan_path, const std::string& result_dir,
+GT_API EvalMetrics evaluate_files(const std::string& scan_path, const std::string& result_dir,
                            const EvalOptions& options = {});
 
 /// metrics.json contents (metres and degrees; NaN as null). `truth` and `result` are recorded.
-std::string metrics_json(const EvalMetrics& metrics, const std::string& truth,
+GT_API std::string metrics_json(const EvalMetrics& metrics, const std::string& truth,
                          const std::string& result);
 /// A short human summary (millimetres), several lines.
-std::string metrics_summary(const EvalMetrics& metrics);
+GT_API std::string metrics_summary(const EvalMetrics& metrics);
 
 }  // namespace groovetrace

@@ -7,6 +7,7 @@
 //
 // Frames and units: every 3-D quantity is in the cloud's frame, metres; angles in degrees.
 
+#include <groovetrace/export.hpp>
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
@@ -75,7 +76,7 @@ struct SeamCandidate {
 /// continuous. An open seam ends at larger x of the cloud's frame than it starts (ties: y, then
 /// z); a closed seam starts at its smallest x, runs counter-clockwise about its mean top
 /// normal and ends where it started.
-Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
+GT_API Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
 /// Everything the robust method decided.
 struct RobustDetection {
@@ -94,10 +95,10 @@ struct RobustDetection {
 /// throws for "no groove": the caller checks whether any seam is accepted. `lap`, when given,
 /// is called after each stage with its name ("candidates", "seams", "region"). The crease
 /// measure runs on `backend`; the rest, and everything without a backend, on the CPU.
-RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
+GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               FeatureBackend& backend,
                               const std::function<void(const std::string&)>& lap = {});
-RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
+GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               const std::function<void(const std::string&)>& lap = {});
 
 }  // namespace groovetrace

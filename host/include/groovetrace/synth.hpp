@@ -11,6 +11,7 @@
 // left imager's centre; the right imager sits at (+baseline, 0, 0). `T_workpiece_camera`
 // maps camera coordinates to workpiece coordinates: p_workpiece = T_workpiece_camera * p_camera.
 
+#include <groovetrace/export.hpp>
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <groovetrace/cloud.hpp>
@@ -32,11 +33,11 @@ enum class Shape {
 
 /// Lower-case CLI name of a shape ("straight", "curve", "box", "cylinder", "pipe-long",
 /// "lshape", "multi").
-const char* shape_name(Shape shape);
+GT_API const char* shape_name(Shape shape);
 /// Inverse of shape_name; throws UsageError listing the known names.
-Shape parse_shape(const std::string& name);
+GT_API Shape parse_shape(const std::string& name);
 /// All shape names, in enum order.
-std::vector<std::string> shape_names();
+GT_API std::vector<std::string> shape_names();
 
 /// Which sensor effects the D415 model applies (all only when SynthParams::noise is on).
 struct SensorEffects {
@@ -59,9 +60,9 @@ struct SensorEffects {
 /// Parses a comma-separated effect list: "all", "none", or names from
 /// {depth,undulation,blur,flying,grazing,shadow,band,dropout,minz,quantize}; the named effects
 /// are on, the others off. Throws UsageError for an unknown name.
-SensorEffects parse_effects(const std::string& list);
+GT_API SensorEffects parse_effects(const std::string& list);
 /// The comma-separated names of the effects that are on ("none" if no effect is on).
-std::string effects_string(const SensorEffects& effects);
+GT_API std::string effects_string(const SensorEffects& effects);
 
 /// D415 constants of the sensor model. Defaults follow docs/design.md; change them to model
 /// another stereo camera.
@@ -104,7 +105,7 @@ struct SynthParams {
 };
 
 /// Checks parameter ranges; throws UsageError naming the offending parameter.
-void validate(const SynthParams& params);
+GT_API void validate(const SynthParams& params);
 
 /// The groove's cross-section as built (metres, degrees). The V's walls run from the two top
 /// edges (top_width apart) down to the root at `depth`; below the root a vertical gap of
@@ -118,7 +119,7 @@ struct GrooveGeometry {
 };
 /// The geometry SynthParams describe: depth = (top_width - root_gap) / (2 tan(angle / 2))
 /// unless groove_depth is given; thickness = max(10 mm, depth + 1.5 mm).
-GrooveGeometry groove_geometry(const SynthParams& params);
+GT_API GrooveGeometry groove_geometry(const SynthParams& params);
 
 /// Pinhole camera (no distortion, as RealSense depth streams). Pixel (u, v) = (column, row)
 /// looks along (u - cx) / fx, (v - cy) / fy, 1 in the camera frame.
@@ -131,7 +132,7 @@ struct CameraModel {
 /// D415 intrinsics at a resolution: fx = 0.5 width / tan(HFOV / 2); fy from the VFOV of the
 /// native 16:9 frame, fy = 0.5 (width * 9 / 16) / tan(VFOV / 2) (so 4:3 modes see more rows);
 /// cx = (width - 1) / 2, cy = (height - 1) / 2. 1280x720: fx 1004.6, fy 989.1.
-CameraModel d415_camera(int width, int height, const SensorModel& sensor = {});
+GT_API CameraModel d415_camera(int width, int height, const SensorModel& sensor = {});
 
 /// One seam's true root line. Vertices are about 1 mm apart; a closed seam repeats its first
 /// vertex at the end. All vectors in the frame of the container (camera frame in SynthTruth).
@@ -169,7 +170,7 @@ struct SynthScan {
 
 /// Renders a scan. Deterministic: the same params (seed included) give the same bytes,
 /// independent of the thread count. Throws UsageError for invalid params.
-SynthScan render(const SynthParams& params);
+GT_API SynthScan render(const SynthParams& params);
 
 // --- Files --------------------------------------------------------------------------------
 
@@ -180,13 +181,13 @@ struct SynthFiles {
   std::string scan, truth, labels;
 };
 /// File names for a scan path, which must end in ".pcd" (UsageError otherwise).
-SynthFiles synth_files(const std::string& scan_path);
+GT_API SynthFiles synth_files(const std::string& scan_path);
 
 /// Writes SCAN.pcd and its truth files, each atomically. Returns their names.
-SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path);
+GT_API SynthFiles write_synth_scan(const SynthScan& scan, const std::string& scan_path);
 
 /// Reads the truth of SCAN.pcd (its .truth.json and .labels.pcd; the scan itself is not
 /// read). Throws InputError for missing or malformed files.
-SynthTruth read_synth_truth(const std::string& scan_path);
+GT_API SynthTruth read_synth_truth(const std::string& scan_path);
 
 }  // namespace groovetrace
