@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "param_flags.hpp"
 #include "pending_backend.hpp"
 
 namespace groovetrace::cli {
@@ -22,17 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 
 struct RunOptions {
-  std::string scan, out_dir, config;
+  std::string scan, out_dir;
   bool quiet = false;
-  std::map<std::string, std::string> flags;  // param key -> text, only for flags given
+  std::shared_ptr<ParamFlags> params = std::make_shared<ParamFlags>();
 };
-
-std::string dashed(std::string key) {
-  for (char& c : key) {
-    if (c == '_') c = '-';
-  }
-  return key;
-}
 
 // Fails before any work if OUTDIR cannot be created or written, so a long run is not lost.
 void check_output_dir(const std::string& dir) {
@@ -51,33 +45,10 @@ void check_output_dir(const std::string& dir) {
   }
 }
 
-// The config file, then the flags; warnings for the keys that the chosen method ignores.
-Params parse_params(const RunOptions& opt, std::vector<std::string>& warnings) {
-  Params params;
-  std::vector<std::string> keys;
-  if (!opt.config.empty()) keys = apply_config_file(params, opt.config);
-  for (const auto& [key, text] : opt.flags) {
-    try {
-      set_param(params, key, text);
-    } catch (const UsageError& e) {
-      throw UsageError("--" + dashed(key) + ": " + std::string(e.what()).substr(key.size() + 2));
-    }
-    keys.push_back(key);
-  }
-  validate(params);
-  for (const std::string& key : keys) {
-    const std::string w = other_method_warning(params, key);
-    if (!w.empty() && std::find(warnings.begin(), warnings.end(), w) == warnings.end()) {
-      warnings.push_back(w);
-    }
-  }
-  return params;
-}
-
 int run(const RunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> param_warnings;
-  const Params params = parse_params(opt, param_warnings);
+  const Params params = parse_params(*opt.params, param_warnings);
   check_output_dir(opt.out_dir);
   auto say = [&](const char* fmt, auto... args) {
     if (!opt.quiet) {
@@ -137,13 +108,8 @@ Command add_run_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("run", "detect the groove in SCAN and write the outputs");
   sub->add_option("scan", opt->scan, "input scan (.pcd or .ply)")->required();
   sub->add_option("-o,--output", opt->out_dir, "output directory (created if missing)")->required();
-  sub->add_option("--config", opt->config, "YAML or JSON file of parameters (flags win)");
   sub->add_flag("-q,--quiet", opt->quiet, "print nothing but warnings and errors");
-  for (const auto& spec : param_specs()) {
-    const std::string key = spec.key;
-    sub->add_option_function<std::string>(
-        "--" + dashed(key), [opt, key](const std::string& v) { opt->flags[key] = v; }, spec.help);
-  }
+  add_param_flags(sub, opt->params);
   return {sub, [opt] { return run(*opt); }};
 }
 

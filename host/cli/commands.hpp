@@ -17,5 +17,7 @@ struct Command {
 Command add_run_command(CLI::App& app);
 Command add_synth_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
+Command add_batch_command(CLI::App& app);
+Command add_report_command(CLI::App& app);
 
 }  // namespace groovetrace::cli

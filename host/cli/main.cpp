@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
       groovetrace::cli::add_run_command(app),
       groovetrace::cli::add_synth_command(app),
       groovetrace::cli::add_eval_command(app),
+      groovetrace::cli::add_batch_command(app),
+      groovetrace::cli::add_report_command(app),
   };
   try {
     app.parse(argc, argv);

@@ -1,0 +1,49 @@
+#include "param_flags.hpp"
+
+#include <algorithm>
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
+#include <groovetrace/pipeline.hpp>
+
+namespace groovetrace::cli {
+
+std::string dashed(std::string key) {
+  for (char& c : key) {
+    if (c == '_') c = '-';
+  }
+  return key;
+}
+
+void add_param_flags(CLI::App* sub, const std::shared_ptr<ParamFlags>& given) {
+  sub->add_option("--config", given->config, "YAML or JSON file of parameters (flags win)");
+  for (const auto& spec : param_specs()) {
+    const std::string key = spec.key;
+    sub->add_option_function<std::string>(
+        "--" + dashed(key), [given, key](const std::string& v) { given->flags[key] = v; },
+        spec.help);
+  }
+}
+
+Params parse_params(const ParamFlags& given, std::vector<std::string>& warnings) {
+  Params params;
+  std::vector<std::string> keys;
+  if (!given.config.empty()) keys = apply_config_file(params, given.config);
+  for (const auto& [key, text] : given.flags) {
+    try {
+      set_param(params, key, text);
+    } catch (const UsageError& e) {
+      throw UsageError("--" + dashed(key) + ": " + std::string(e.what()).substr(key.size() + 2));
+    }
+    keys.push_back(key);
+  }
+  validate(params);
+  for (const std::string& key : keys) {
+    const std::string w = other_method_warning(params, key);
+    if (!w.empty() && std::find(warnings.begin(), warnings.end(), w) == warnings.end()) {
+      warnings.push_back(w);
+    }
+  }
+  return params;
+}
+
+}  // namespace groovetrace::cli

@@ -1,0 +1,227 @@
+#include "batch/jobs.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <groovetrace/error.hpp>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace groovetrace::batch {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool is_scan(const fs::path& p) {
+  const std::string ext = lower(p.extension().string());
+  return ext == ".pcd" || ext == ".ply";
+}
+
+// `groovetrace synth` writes SCAN.pcd with its ground truth beside it: SCAN.truth.json and
+// SCAN.labels.pcd. The labels are not a scan.
+bool is_synth_labels(const fs::path& p) {
+  const std::string name = p.filename().string();
+  const std::string suffix = ".labels.pcd";
+  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(),
+                                                   suffix) != 0) {
+    return false;
+  }
+  const std::string stem = name.substr(0, name.size() - suffix.size());
+  std::error_code ec;
+  return fs::exists(p.parent_path() / (stem + ".truth.json"), ec);
+}
+
+std::string without_extension(const fs::path& rel) {
+  return (rel.parent_path() / rel.stem()).generic_string();
+}
+
+std::vector<ScanJob> scans_in_directory(const fs::path& root) {
+  std::vector<ScanJob> jobs;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(root, ec); !ec && it != fs::end(it);
+       it.increment(ec)) {
+    if (!it->is_regular_file(ec) || !is_scan(it->path()) || is_synth_labels(it->path())) continue;
+    jobs.push_back({it->path().string(), without_extension(fs::relative(it->path(), root)), "", "",
+                    std::nullopt});
+  }
+  if (ec) throw InputError("cannot list " + root.string() + ": " + ec.message());
+  return jobs;
+}
+
+// A CSV line split at commas outside double quotes ("" inside quotes is a quote).
+std::vector<std::string> csv_cells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
+      cells.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      cells.emplace_back();
+    } else if (c != '\r') {
+      cells.back() += c;
+    }
+  }
+  return cells;
+}
+
+Eigen::Vector3f parse_viewpoint(const std::string& text, const std::string& where) {
+  std::istringstream in(text);
+  Eigen::Vector3f v;
+  std::string rest;
+  if (!(in >> v.x() >> v.y() >> v.z()) || (in >> rest) || !v.allFinite()) {
+    throw InputError(where + ": viewpoint must be three numbers \"X Y Z\" (m), got '" + text + "'");
+  }
+  return v;
+}
+
+std::string extension_of(const ScanJob& job) {
+  return lower(fs::path(job.path).extension().string().substr(1));
+}
+
+// Makes every job's directory unique: where scans of different types share one, each gets its
+// extension (x.pcd, x.ply: x_pcd, x_ply); scans that still share one are counted (s1, s1_2).
+void make_unique(std::vector<ScanJob>& jobs) {
+  std::map<std::string, std::set<std::string>> extensions;
+  for (const ScanJob& j : jobs) extensions[j.rel].insert(extension_of(j));
+  for (ScanJob& j : jobs) {
+    if (extensions[j.rel].size() > 1) j.rel += "_" + extension_of(j);
+  }
+  std::map<std::string, int> seen;
+  for (ScanJob& j : jobs) {
+    const int n = seen[j.rel]++;
+    if (n > 0) j.rel += "_" + std::to_string(n + 1);
+  }
+}
+
+}  // namespace
+
+std::vector<ScanJob> read_manifest(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot read manifest " + path);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = csv_cells(line);
+  std::map<std::string, std::size_t> column;
+  for (std::size_t c = 0; c < header.size(); ++c) column[header[c]] = c;
+  if (!column.count("scan")) {
+    throw InputError("manifest " + path + ": the header must name a 'scan' column, got '" + line +
+                     "'");
+  }
+  const fs::path base = fs::path(path).parent_path();
+  auto file = [&](const std::vector<std::string>& row, const char* name) -> std::string {
+    if (!column.count(name) || row.size() <= column[name] || row[column[name]].empty()) return "";
+    return (base / row[column[name]]).string();
+  };
+  std::vector<ScanJob> jobs;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<std::string> row = csv_cells(line);
+    const std::string where = "manifest " + path + " line " + std::to_string(n);
+    if (row.size() != header.size()) throw InputError(where + ": " + std::to_string(row.size()) +
+                                                      " cells, the header has " +
+                                                      std::to_string(header.size()));
+    ScanJob job{file(row, "scan"), without_extension(row[column["scan"]]), file(row, "flange_pose"),
+                file(row, "hand_eye"), std::nullopt};
+    if (job.path.empty()) throw InputError(where + ": no scan");
+    if (column.count("viewpoint") && !row[column["viewpoint"]].empty()) {
+      job.viewpoint = parse_viewpoint(row[column["viewpoint"]], where);
+    }
+    jobs.push_back(job);
+  }
+  return jobs;
+}
+
+std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
+  std::vector<ScanJob> jobs;
+  for (const std::string& input : inputs) {
+    std::error_code ec;
+    const fs::path p(input);
+    std::vector<ScanJob> found;
+    if (fs::is_directory(p, ec)) {
+      found = scans_in_directory(p);
+    } else if (fs::is_regular_file(p, ec) && lower(p.extension().string()) == ".csv") {
+      found = read_manifest(input);
+    } else if (fs::exists(p, ec)) {
+      found.push_back({input, p.stem().string(), "", "", std::nullopt});
+    } else {
+      throw InputError("input " + input + " does not exist");
+    }
+    jobs.insert(jobs.end(), found.begin(), found.end());
+  }
+  if (jobs.empty()) throw InputError("no scan (.pcd or .ply) in the inputs");
+  auto by_dir = [](const ScanJob& a, const ScanJob& b) {
+    return a.rel != b.rel ? a.rel < b.rel : a.path < b.path;
+  };
+  std::stable_sort(jobs.begin(), jobs.end(), by_dir);
+  make_unique(jobs);
+  std::stable_sort(jobs.begin(), jobs.end(), by_dir);
+  return jobs;
+}
+
+std::vector<ScanJob> shard(const std::vector<ScanJob>& jobs, int index, int count) {
+  std::vector<ScanJob> mine;
+  for (std::size_t i = static_cast<std::size_t>(index); i < jobs.size();
+       i += static_cast<std::size_t>(count)) {
+    mine.push_back(jobs[i]);
+  }
+  return mine;
+}
+
+void parse_shard(const std::string& text, int& index, int& count) {
+  const auto slash = text.find('/');
+  try {
+    std::size_t used_k = 0, used_n = 0;
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    const int k = std::stoi(text.substr(0, slash), &used_k);
+    const int n = std::stoi(text.substr(slash + 1), &used_n);
+    if (used_k != slash || used_n != text.size() - slash - 1 || n < 1 || k < 0 || k >= n) {
+      throw std::invalid_argument("range");
+    }
+    index = k;
+    count = n;
+  } catch (const std::exception&) {
+    throw UsageError("--shard: expected K/N with 0 <= K < N, got '" + text + "'");
+  }
+}
+
+bool shard_from_environment(int count_given, int& index, int& count) {
+  // A set variable must hold a non-negative integer.
+  auto number = [](const char* name, int& out) {
+    const char* v = std::getenv(name);
+    if (!v || !*v) return false;
+    char* end = nullptr;
+    const long n = std::strtol(v, &end, 10);
+    if (*end != '\0' || n < 0 || n > 1000000000) {
+      throw UsageError(std::string(name) + ": expected a non-negative integer, got '" + v + "'");
+    }
+    out = static_cast<int>(n);
+    return true;
+  };
+  int id = 0, n = 0, min = 0;
+  if (number("SLURM_ARRAY_TASK_ID", id) && number("SLURM_ARRAY_TASK_COUNT", n)) {
+    number("SLURM_ARRAY_TASK_MIN", min);
+    parse_shard(std::to_string(id - min) + "/" + std::to_string(n), index, count);
+    return true;
+  }
+  if (number("JOB_COMPLETION_INDEX", id)) {
+    if (count_given < 1) {
+      throw UsageError("JOB_COMPLETION_INDEX is set: give the shard count as --shard-count N");
+    }
+    parse_shard(std::to_string(id) + "/" + std::to_string(count_given), index, count);
+    return true;
+  }
+  return false;
+}
+
+}  // namespace groovetrace::batch

@@ -1,0 +1,130 @@
+// The scans of a batch: folders, files and manifests expanded into jobs with directories that
+// never collide, and the shards of a job array.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <groovetrace/error.hpp>
+
+#include "batch/jobs.hpp"
+#include "batch/row.hpp"
+#include "support/cli_runner.hpp"
+
+namespace groovetrace::batch {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> rels(const std::vector<ScanJob>& jobs) {
+  std::vector<std::string> out;
+  for (const ScanJob& j : jobs) out.push_back(j.rel);
+  return out;
+}
+
+void touch(const fs::path& p) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << "x";
+}
+
+TEST(BatchJobs, FoldersAreSearchedSortedAndNamesNeverCollide) {
+  const fs::path d = test::fresh_dir("batch_jobs_folders");
+  touch(d / "in" / "b" / "scan.pcd");
+  touch(d / "in" / "a" / "scan.pcd");
+  touch(d / "in" / "a" / "scan.PLY");        // same stem, other extension
+  touch(d / "in" / "a" / "notes.txt");       // not a scan
+  touch(d / "in" / "a" / "s1.pcd");
+  touch(d / "in" / "a" / "s1.labels.pcd");   // synth's ground truth beside s1.truth.json
+  touch(d / "in" / "a" / "s1.truth.json");
+  touch(d / "in" / "a" / "x.labels.pcd");    // no truth beside it: a scan
+  touch(d / "other" / "a" / "s1.pcd");       // same relative path under a second input
+  const auto jobs = list_jobs({(d / "in").string(), (d / "other").string()});
+  EXPECT_EQ(rels(jobs), (std::vector<std::string>{"a/s1", "a/s1_2", "a/scan_pcd", "a/scan_ply",
+                                                   "a/x.labels", "b/scan"}));
+  EXPECT_EQ(jobs[1].path, (d / "other" / "a" / "s1.pcd").string());
+  EXPECT_THROW(list_jobs({(d / "missing").string()}), InputError);
+  fs::create_directories(d / "nothing");
+  EXPECT_THROW(list_jobs({(d / "nothing").string()}), InputError);
+}
+
+TEST(BatchJobs, ManifestCarriesEachCapturesPose) {
+  const fs::path d = test::fresh_dir("batch_jobs_manifest");
+  std::ofstream(d / "night.csv") << "scan,flange_pose,viewpoint\n"
+                                    "cell1/a.pcd,poses/a.yaml,\"0.1 0.2 0.3\"\n"
+                                    "\n"
+                                    "cell1/b.ply,,\n";
+  const auto jobs = list_jobs({(d / "night.csv").string()});
+  ASSERT_EQ(jobs.size(), 2u);
+  EXPECT_EQ(jobs[0].rel, "cell1/a");
+  EXPECT_EQ(jobs[0].path, (d / "cell1" / "a.pcd").string());
+  EXPECT_EQ(jobs[0].flange_pose, (d / "poses" / "a.yaml").string());
+  EXPECT_EQ(jobs[0].hand_eye, "");
+  ASSERT_TRUE(jobs[0].viewpoint.has_value());
+  EXPECT_FLOAT_EQ(jobs[0].viewpoint->z(), 0.3f);
+  EXPECT_EQ(jobs[1].flange_pose, "");
+  EXPECT_FALSE(jobs[1].viewpoint.has_value());
+
+  std::ofstream(d / "no_scan.csv") << "file\na.pcd\n";
+  EXPECT_THROW(read_manifest((d / "no_scan.csv").string()), InputError);
+  std::ofstream(d / "ragged.csv") << "scan,flange_pose\na.pcd\n";
+  EXPECT_THROW(read_manifest((d / "ragged.csv").string()), InputError);
+  std::ofstream(d / "bad_view.csv") << "scan,viewpoint\na.pcd,1 2\n";
+  EXPECT_THROW(read_manifest((d / "bad_view.csv").string()), InputError);
+}
+
+TEST(BatchJobs, ShardsSplitTheSortedList) {
+  std::vector<ScanJob> jobs(7);
+  for (int i = 0; i < 7; ++i) jobs[i].rel = std::to_string(i);
+  EXPECT_EQ(rels(shard(jobs, 0, 3)), (std::vector<std::string>{"0", "3", "6"}));
+  EXPECT_EQ(rels(shard(jobs, 2, 3)), (std::vector<std::string>{"2", "5"}));
+  int k = -1, n = -1;
+  parse_shard("1/4", k, n);
+  EXPECT_EQ(k, 1);
+  EXPECT_EQ(n, 4);
+  for (const char* bad : {"4/4", "-1/2", "1/0", "1", "a/b", "1/2x", ""}) {
+    EXPECT_THROW(parse_shard(bad, k, n), UsageError) << bad;
+  }
+}
+
+TEST(BatchJobs, ShardFromTheEnvironment) {
+  ::unsetenv("JOB_COMPLETION_INDEX");
+  ::setenv("SLURM_ARRAY_TASK_ID", "5", 1);
+  ::setenv("SLURM_ARRAY_TASK_COUNT", "3", 1);
+  ::setenv("SLURM_ARRAY_TASK_MIN", "4", 1);  // --array=4-6
+  int k = -1, n = -1;
+  EXPECT_TRUE(shard_from_environment(0, k, n));
+  EXPECT_EQ(k, 1);
+  EXPECT_EQ(n, 3);
+  ::setenv("SLURM_ARRAY_TASK_ID", "x", 1);
+  EXPECT_THROW(shard_from_environment(0, k, n), UsageError);
+  ::unsetenv("SLURM_ARRAY_TASK_ID");
+  ::unsetenv("SLURM_ARRAY_TASK_COUNT");
+  ::unsetenv("SLURM_ARRAY_TASK_MIN");
+  EXPECT_FALSE(shard_from_environment(0, k, n));
+  ::setenv("JOB_COMPLETION_INDEX", "2", 1);
+  EXPECT_THROW(shard_from_environment(0, k, n), UsageError);  // the count must be given
+  EXPECT_TRUE(shard_from_environment(4, k, n));
+  EXPECT_EQ(k, 2);
+  EXPECT_EQ(n, 4);
+  ::unsetenv("JOB_COMPLETION_INDEX");
+}
+
+TEST(BatchRows, JsonRoundTripAndCsvQuoting) {
+  ScanRow r;
+  r.scan = "a,b \"quoted\".pcd";
+  r.dir = "a/b";
+  r.status = "invalid_input";
+  r.exit_code = 3;
+  r.message = "line one, with a comma";
+  r.stages_ms = {{"load", 1.5}, {"candidates", 20}};
+  r.input_hash = hex64(fnv1a64("abc"));
+  const ScanRow back = row_from_json(row_json(r), "test");
+  EXPECT_EQ(back.scan, r.scan);
+  EXPECT_EQ(back.stages_ms, r.stages_ms);
+  EXPECT_EQ(back.input_hash, "e71fa2190541574b");  // FNV-1a 64 of "abc", a published test vector
+  EXPECT_EQ(csv_line(r).substr(0, 25), "\"a,b \"\"quoted\"\".pcd\",a/b,");
+  EXPECT_THROW(row_from_json("{}", "test"), InputError);
+}
+
+}  // namespace
+}  // namespace groovetrace::batch
