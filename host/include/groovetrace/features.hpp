@@ -24,7 +24,7 @@ struct FeatureSet {
   std::vector<float> descriptor;     ///< D (deg^2), NaN where undefined
 };
 
-/// Settings of the robust method's crease measure (robust.hpp, crease_map).
+/// Settings of the robust method's crease measure (docs/method-robust.md, "Candidates").
 struct CreaseParams {
   float radius = 0.010f;      ///< ball of the plane fit and of the envelope (m)
   float own_radius = 0.003f;  ///< ball over which a point's own height is averaged (m)

@@ -9,12 +9,11 @@
 #include <groovetrace/trajectory.hpp>
 #include <limits>
 #include <string>
+#include "core/stats.hpp"
 
 namespace groovetrace {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 /// Yaw, pitch, roll (deg) with R = Rz(yaw) Ry(pitch) Rx(roll); pitch in [-90, 90].
 Eigen::Vector3d euler_zyx_deg(const Eigen::Matrix3d& R) {
@@ -32,7 +31,7 @@ Eigen::Vector3d euler_zyx_deg(const Eigen::Matrix3d& R) {
     // R(0,1) = -sin(yaw) and R(1,1) = cos(yaw).
     yaw = std::atan2(-R(0, 1), R(1, 1));
   }
-  return {yaw * kRadToDeg, pitch * kRadToDeg, roll * kRadToDeg};
+  return {rad_to_deg(yaw), rad_to_deg(pitch), rad_to_deg(roll)};
 }
 
 }  // namespace

@@ -10,16 +10,16 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+#include "core/stats.hpp"
 
 namespace groovetrace {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   // atan2 of |cross| and dot stays accurate near 0 and 180 deg, where acos loses digits.
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
+  return rad_to_deg(std::atan2(a.cross(b).norm(), a.dot(b)));
 }
 
 // The nearest point on the true root lines to a query, with the truth's frame there.

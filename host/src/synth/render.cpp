@@ -9,6 +9,8 @@
 
 #include "synth/internal.hpp"
 
+#include "core/stats.hpp"
+
 namespace groovetrace {
 namespace {
 
@@ -158,7 +160,7 @@ SynthScan render(const SynthParams& params) {
       // (simulate_sensor), so no detector can see the groove there.
       if (sensor_limits && params.effects.grazing_dropout) {
         const double cos_incidence = seam.normal[k].normalized().dot((eye - p).normalized());
-        in = in && cos_incidence >= std::cos(params.sensor.grazing_full_deg * M_PI / 180.0);
+        in = in && cos_incidence >= std::cos(deg_to_rad(params.sensor.grazing_full_deg));
       }
       const Eigen::Vector3d opening = p + truth.groove.depth * seam.bisector[k];
       in = in && !scene.occluded(eye, opening, kShadowTolerance);

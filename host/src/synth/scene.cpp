@@ -17,6 +17,8 @@
 
 #include "synth/internal.hpp"
 
+#include "core/stats.hpp"
+
 namespace groovetrace {
 namespace {
 
@@ -387,7 +389,7 @@ GrooveGeometry groove_geometry(const SynthParams& params) {
     g.included_angle_deg = 2.0 * std::atan(run / g.depth) * 180.0 / kPi;
   } else {
     g.included_angle_deg = params.groove_angle_deg;
-    g.depth = run / std::tan(0.5 * params.groove_angle_deg * kPi / 180.0);
+    g.depth = run / std::tan(deg_to_rad(0.5 * params.groove_angle_deg));
   }
   g.thickness = std::max(0.010, g.depth + 0.0015);
   return g;

@@ -19,6 +19,8 @@
 
 #include "synth/internal.hpp"
 
+#include "core/stats.hpp"
+
 namespace groovetrace {
 namespace {
 
@@ -117,8 +119,8 @@ CameraModel d415_camera(int width, int height, const SensorModel& sensor) {
   CameraModel c;
   c.width = width;
   c.height = height;
-  c.fx = 0.5 * width / std::tan(0.5 * sensor.hfov_deg * kPi / 180.0);
-  c.fy = 0.5 * (width * 9.0 / 16.0) / std::tan(0.5 * sensor.vfov_deg * kPi / 180.0);
+  c.fx = 0.5 * width / std::tan(deg_to_rad(0.5 * sensor.hfov_deg));
+  c.fy = 0.5 * (width * 9.0 / 16.0) / std::tan(deg_to_rad(0.5 * sensor.vfov_deg));
   c.cx = 0.5 * (width - 1);
   c.cy = 0.5 * (height - 1);
   return c;
@@ -311,7 +313,7 @@ Cloud to_points(const IdealFrame& ideal, const std::vector<double>& d3, const Ca
   cloud.height = static_cast<std::uint32_t>(H);
   cloud.resize(static_cast<std::size_t>(W) * H);
   cloud.viewpoint.setZero();
-  const double cos_start = std::cos(m.grazing_start_deg * kPi / 180.0);
+  const double cos_start = std::cos(deg_to_rad(m.grazing_start_deg));
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < H; ++v) {
     Variates rng(row_seeds[v]);

@@ -11,15 +11,14 @@
 
 #include "backend/cpu/crease.hpp"
 #include "core/neighbor_grid.hpp"
+#include "core/stats.hpp"
 
 namespace groovetrace {
 namespace {
 
-constexpr double kRadToDeg = 57.295779513082320876;
-
 double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
   const double c = std::clamp(static_cast<double>(a.dot(b)), -1.0, 1.0);
-  return std::acos(c) * kRadToDeg;
+  return rad_to_deg(std::acos(c));
 }
 
 // Weighted plane (and optionally quadric) fit around point i; returns the projected point.

@@ -3,23 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
+#include "core/stats.hpp"
 
 namespace groovetrace::ocl {
 namespace {
 
 constexpr float kMaxSlack = 1.0f;  // pixels; beyond, windows grow past the cost of the grid
 
-double median(std::vector<double>& v) {
-  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 // Pixels per unit of x/z (the focal length) from steps of `gap` pixels, or 0 when the steps
 // disagree.
 double focal_length(std::vector<double>& steps, int gap) {
   if (steps.size() < 16) return 0;
-  const double m = median(steps);
+  const double m = upper_median(steps);
   if (!(std::abs(m) > 0) || !std::isfinite(m)) return 0;
   const auto agree = std::count_if(steps.begin(), steps.end(),
                                    [&](double s) { return std::abs(s - m) <= 0.05 * std::abs(m); });
@@ -66,9 +61,9 @@ FrameIntrinsics estimate_intrinsics(const Cloud& cloud) {
   }
   if (ox.size() < 16) return out;
   std::vector<double> tmp = ox;
-  const double cx = median(tmp);
+  const double cx = upper_median(tmp);
   tmp = oy;
-  const double cy = median(tmp);
+  const double cy = upper_median(tmp);
   std::vector<double> residual(ox.size());
   for (std::size_t k = 0; k < ox.size(); ++k) {
     residual[k] = std::max(std::abs(ox[k] - cx), std::abs(oy[k] - cy));
