@@ -7,7 +7,7 @@ pkgs=(build-essential cmake pkg-config
       pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
       libgtest-dev libgmock-dev libbenchmark-dev clang-format
       libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
-      python3-numpy python3-matplotlib)
+      python3-numpy python3-matplotlib chromium)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -44,6 +44,20 @@ std::size_t count_files(const fs::path& dir, const std::string& suffix) {
   return n;
 }
 
+// index.html as a person sees it: Chromium (Debian's, installed by scripts/setup.sh) loads it
+// from the file system headless; returns the DOM after load and fills `log` with what the
+// browser said (resource and script errors land there).
+std::string browser_dom(const fs::path& html, const fs::path& scratch, std::string& log) {
+  const fs::path profile = scratch / "chromium-profile";
+  const auto r = test::run_cli_command(
+      "chromium --headless --no-sandbox --disable-gpu --enable-logging=stderr --v=0 "
+      "--user-data-dir=" + profile.string() + " --dump-dom file://" + html.string(),
+      scratch);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  log = r.err;
+  return r.out;
+}
+
 class CliBatch : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -101,6 +115,20 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   }
   // The failures come first, with their messages.
   EXPECT_LT(html.find("Segmentation fault"), html.find("id=\"scans\""));
+
+  // Chromium loads the page with no resource or script error, and it lists every scan.
+  std::string log;
+  const std::string dom = browser_dom(dir_ / "out" / "index.html", dir_, log);
+  for (const auto& [d, status] : expected) {
+    EXPECT_NE(dom.find("data-dir=\"" + d + "\""), std::string::npos) << d;
+  }
+  EXPECT_NE(dom.find("7 scans"), std::string::npos);
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;  // script errors
+  // Every picture the page shows is there (a broken image is no console error).
+  for (auto at = dom.find("src=\""); at != std::string::npos; at = dom.find("src=\"", at + 1)) {
+    const std::string src = dom.substr(at + 5, dom.find('"', at + 5) - at - 5);
+    EXPECT_TRUE(fs::exists(dir_ / "out" / src)) << src;
+  }
 
   // `report` rebuilds the same rows from the directories alone.
   fs::remove(dir_ / "out" / "summary.csv");

@@ -31,13 +31,10 @@ inline std::filesystem::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-/// `args` is appended to the CLI path as shell words (quote paths with spaces yourself);
-/// `env` (e.g. "VAR=value") is put before the command.
-inline CliResult run_cli(const std::string& args, const std::filesystem::path& scratch,
-                         const std::string& env = "") {
+/// Runs a shell command line, capturing its exit code, stdout and stderr.
+inline CliResult run_cli_command(const std::string& command, const std::filesystem::path& scratch) {
   const auto out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-  const std::string cmd = env + " " + std::string(GT_CLI_PATH) + " " + args + " >" +
-                          out.string() + " 2>" + err.string();
+  const std::string cmd = command + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -46,6 +43,13 @@ inline CliResult run_cli(const std::string& args, const std::filesystem::path& s
   std::filesystem::remove(out);
   std::filesystem::remove(err);
   return r;
+}
+
+/// `args` is appended to the CLI path as shell words (quote paths with spaces yourself);
+/// `env` (e.g. "VAR=value") is put before the command.
+inline CliResult run_cli(const std::string& args, const std::filesystem::path& scratch,
+                         const std::string& env = "") {
+  return run_cli_command(env + " " + std::string(GT_CLI_PATH) + " " + args, scratch);
 }
 
 }  // namespace groovetrace::test
