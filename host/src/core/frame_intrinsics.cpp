@@ -1,10 +1,10 @@
-#include "frame_intrinsics.hpp"
+#include "core/frame_intrinsics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-namespace groovetrace::ocl {
+namespace groovetrace {
 namespace {
 
 constexpr float kMaxSlack = 1.0f;  // pixels; beyond, windows grow past the cost of the grid
@@ -86,4 +86,4 @@ FrameIntrinsics estimate_intrinsics(const Cloud& cloud) {
   return out;
 }
 
-}  // namespace groovetrace::ocl
+}  // namespace groovetrace
