@@ -134,7 +134,7 @@ inline Cand cand_begin(const Search* s, bool organized, const Queries* Q) {
   if (organized) {
     // One ellipse for all lanes (the largest), centred on each lane's own pixel; the 1e-3
     // margins cover the error of the estimated focal lengths, twice the slack a query and a
-    // candidate sitting off their pixels (see host/src/backend/opencl/frame_intrinsics.hpp).
+    // candidate sitting off their pixels (see host/src/core/frame_intrinsics.hpp).
     const float rad = hmax_float(SEL((vfloat)(0.0f), window_radius(Q->p, s->radius), Q->ok));
     it.rx = s->fx * rad * 1.001f + 1e-3f + 2.0f * s->slack;
     it.ry = s->fy * rad * 1.001f + 1e-3f + 2.0f * s->slack;

@@ -193,8 +193,8 @@ def run_one(binary, backend, scan, truth, seed, out, shape, method):
     tag = method or "default"
     rdir = os.path.join(out, "runs", f"{shape}-{seed}", tag)
     os.makedirs(rdir, exist_ok=True)
-    for stale in ("annotated.pcd", "trajectory.csv", "trajectory.json", "report.json",
-                  "metrics.json", "program.script"):
+    for stale in ("annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
+                  "report.json", "metrics.json", "program.script"):
         if os.path.exists(os.path.join(rdir, stale)):
             os.remove(os.path.join(rdir, stale))
     cmd = [binary, "run", scan, "-o", rdir, "--backend", backend, "-q"]

@@ -6,7 +6,7 @@ pkgs=(build-essential cmake pkg-config
       libpcl-dev libeigen3-dev libomp-dev
       pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
       libgtest-dev libgmock-dev libbenchmark-dev clang-format
-      libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
+      libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libpng-dev
       python3-numpy python3-matplotlib chromium)
 missing=()
 for p in "${pkgs[@]}"; do

@@ -55,8 +55,8 @@ TEST_F(CliRobust, GrooveOnABoxWithReportedCandidates) {
   // robust is the default method.
   const auto r = test::run_cli("run " + scan.string() + " -o " + out.string(), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  for (const char* f :
-       {"annotated.pcd", "trajectory.csv", "trajectory.json", "program.script", "report.json"}) {
+  for (const char* f : {"annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
+                        "program.script", "report.json"}) {
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   }
   EXPECT_FALSE(fs::exists(out / "trajectory_1.csv"));

@@ -58,8 +58,8 @@ TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
       "run " + scan_.string() + " -o " + out.string() + " --method paper --backend cpu", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("outputs in"), std::string::npos) << r.out;
-  for (const char* f :
-       {"annotated.pcd", "trajectory.csv", "trajectory.json", "program.script", "report.json"}) {
+  for (const char* f : {"annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
+                        "program.script", "report.json"}) {
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   }
 

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +42,10 @@ struct RunResult {
   /// trajectory_1.csv, ...); camera frame, or base frame when frames were given. Never empty
   /// after a successful run.
   std::vector<Trajectory> trajectories;
+  /// The transform the trajectories were moved by (p_base = T_base_camera * p_camera, the
+  /// camera frame being the cloud's) when calibration files were given; unset when the
+  /// trajectories stay in the cloud's frame.
+  std::optional<Eigen::Isometry3d> T_base_camera;
   std::vector<std::pair<std::string, double>> timings_ms;  ///< per stage, in order
   std::vector<std::string> warnings;
   std::string backend, device;  ///< the backend that ran and its device
@@ -60,8 +65,8 @@ GT_API RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureB
 /// Checks parameter ranges; throws UsageError naming the offending parameter.
 GT_API void validate(const Params& params);
 
-/// The output files of a run, as bytes, keyed by file name (annotated.pcd, trajectory.csv,
-/// trajectory.json, program.script, report.json; with --max-seams N > 1 also
+/// The output files of a run, as bytes, keyed by file name (annotated.pcd, overview.png,
+/// trajectory.csv, trajectory.json, program.script, report.json; with --max-seams N > 1 also
 /// trajectory_K.csv, trajectory_K.json and program_K.script for the K-th next seam).
 GT_API std::vector<std::pair<std::string, std::string>> render_outputs(
     const Cloud& input, const RunResult& result, const Params& params,

@@ -1,5 +1,5 @@
-// The files of a run: annotated cloud, trajectories, robot programs and report.json, rendered
-// as bytes first and then each written atomically.
+// The files of a run: annotated cloud, overview picture, trajectories, robot programs and
+// report.json, rendered as bytes first and then each written atomically.
 
 #include <cmath>
 #include <filesystem>
@@ -10,6 +10,8 @@
 #include <groovetrace/trajectory_io.hpp>
 #include <groovetrace/urscript.hpp>
 #include <nlohmann/json.hpp>
+
+#include "picture/overview.hpp"
 
 namespace groovetrace {
 namespace {
@@ -124,6 +126,20 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   return report.dump(2) + "\n";
 }
 
+// overview.png, drawn in the scan's frame: trajectories moved into the base are moved back.
+std::string overview_png(const Cloud& input, const RunResult& result, const Params& params,
+                         const std::string& input_path) {
+  picture::OverviewInput in(input, result.groove, result.trajectories);
+  if (result.T_base_camera) in.T_cloud_trajectory = result.T_base_camera->inverse();
+  in.viewpoint = params.viewpoint;
+  const std::size_t n = result.warnings.size();
+  const std::string status =
+      n == 0 ? "ok" : std::to_string(n) + (n == 1 ? " warning" : " warnings");
+  in.caption = picture::caption_line(std::filesystem::path(input_path).filename().string(),
+                                     to_string(result.method), result.trajectories, status);
+  return picture::overview_png(in);
+}
+
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& input,
@@ -138,6 +154,7 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
   ann.descriptor = &result.score;
   ann.groove = &result.groove;
   files.emplace_back("annotated.pcd", annotated_pcd_bytes(input, ann));
+  files.emplace_back("overview.png", overview_png(input, result, params, input_path));
   for (std::size_t k = 0; k < result.trajectories.size(); ++k) {
     const std::string n = k == 0 ? "" : "_" + std::to_string(k);
     const Trajectory& t = result.trajectories[k];

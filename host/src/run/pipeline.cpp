@@ -149,6 +149,7 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   }
   if (T_base_camera) {
     for (Trajectory& t : r.trajectories) transform_trajectory(t, *T_base_camera);
+    r.T_base_camera = T_base_camera;
   }
   // Named once the stages are done: a backend still being set up (the CLI's) is waited for
   // only when a stage first needs it.

@@ -16,8 +16,8 @@
 #include <utility>
 
 #include "cl_api.hpp"
+#include "core/frame_intrinsics.hpp"
 #include "device_program.hpp"
-#include "frame_intrinsics.hpp"
 #include "host_blocks.hpp"
 
 namespace groovetrace::ocl {

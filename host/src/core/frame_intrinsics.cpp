@@ -1,11 +1,11 @@
-#include "frame_intrinsics.hpp"
+#include "core/frame_intrinsics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 #include "core/stats.hpp"
 
-namespace groovetrace::ocl {
+namespace groovetrace {
 namespace {
 
 constexpr float kMaxSlack = 1.0f;  // pixels; beyond, windows grow past the cost of the grid
@@ -81,4 +81,4 @@ FrameIntrinsics estimate_intrinsics(const Cloud& cloud) {
   return out;
 }
 
-}  // namespace groovetrace::ocl
+}  // namespace groovetrace

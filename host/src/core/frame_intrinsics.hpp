@@ -1,10 +1,11 @@
 #pragma once
 // The pinhole model of an organized frame, recovered from the points themselves, so that the
-// organized neighbour search can bound its pixel windows without calibration data.
+// OpenCL backend's organized neighbour search can bound its pixel windows, and the overview
+// picture can project seams into the depth image, without calibration data.
 
 #include <groovetrace/cloud.hpp>
 
-namespace groovetrace::ocl {
+namespace groovetrace {
 
 struct FrameIntrinsics {
   bool pinhole = false;  ///< the frame is (close to) a pinhole image in its camera frame
@@ -30,4 +31,4 @@ struct FrameIntrinsics {
 /// percentile cost 40% more time on a 1280x720 frame.
 FrameIntrinsics estimate_intrinsics(const Cloud& cloud);
 
-}  // namespace groovetrace::ocl
+}  // namespace groovetrace
