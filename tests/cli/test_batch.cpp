@@ -123,6 +123,7 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
     EXPECT_NE(dom.find("data-dir=\"" + d + "\""), std::string::npos) << d;
   }
   EXPECT_NE(dom.find("7 scans"), std::string::npos);
+  EXPECT_NE(dom.find("line1/a/thumbnail.png"), std::string::npos);  // the ok scans have pictures
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;  // script errors
   // Every picture the page shows is there (a broken image is no console error).
   for (auto at = dom.find("src=\""); at != std::string::npos; at = dom.find("src=\"", at + 1)) {

@@ -73,7 +73,7 @@ const char* kStyle =
     "body{font:14px sans-serif;margin:1.5em;color:#222}"
     "table{border-collapse:collapse}td,th{border-bottom:1px solid #ddd;padding:4px 8px;"
     "text-align:left;vertical-align:top}.ok{color:#176317}.bad{color:#a11;font-weight:bold}"
-    "img{width:240px;border:1px solid #ccc}.totals span{margin-right:2em}";
+    "img{max-width:240px;border:1px solid #ccc}.totals span{margin-right:2em}";
 
 std::string totals_html(const std::vector<ScanRow>& rows, const RunStats& stats) {
   std::size_t ok = 0;
@@ -107,9 +107,16 @@ std::string failures_html(const std::vector<ScanRow>& rows) {
          "</table>\n";
 }
 
+// What a scan gave: its seams and best path, or why it gave nothing.
+std::string result_cell(const ScanRow& r) {
+  if (r.status != "ok") return "<small>" + html_escape(r.message) + "</small>";
+  return std::to_string(r.seams) + (r.seams == 1 ? " seam" : " seams") + "<br>" +
+         std::to_string(r.waypoints) + " waypoints<br>" + fmt("%.1f", r.length_m * 1000) + " mm";
+}
+
 std::string scan_row_html(const ScanRow& r, const std::string& out_dir) {
   const std::string d = href(r.dir);
-  const bool has_picture = fs::exists(fs::path(out_dir) / r.dir / "overview.png");
+  const bool has_picture = fs::exists(fs::path(out_dir) / r.dir / "thumbnail.png");
   std::string files;
   for (const char* f : {"report.json", "trajectory.csv", "program.script", "annotated.pcd"}) {
     if (fs::exists(fs::path(out_dir) / r.dir / f)) {
@@ -118,12 +125,11 @@ std::string scan_row_html(const ScanRow& r, const std::string& out_dir) {
   }
   return "<tr class=\"scan\" data-dir=\"" + html_escape(r.dir) + "\"><td>" +
          (has_picture ? "<a href=\"" + d + "/overview.png\"><img src=\"" + d +
-                            "/overview.png\" alt=\"overview of " + html_escape(r.dir) + "\"></a>"
+                            "/thumbnail.png\" alt=\"overview of " + html_escape(r.dir) + "\"></a>"
                       : std::string("")) +
          "</td><td>" + html_escape(r.dir) + "<br><small>" + html_escape(r.scan) +
          "</small></td><td class=\"" + (r.status == "ok" ? "ok" : "bad") + "\">" + r.status +
-         "</td><td>" + std::to_string(r.seams) + " seams<br>" + std::to_string(r.waypoints) +
-         " waypoints<br>" + fmt("%.1f", r.length_m * 1000) + " mm</td><td>" +
+         "</td><td>" + result_cell(r) + "</td><td>" +
          fmt("%.0f", r.total_ms) + " ms</td><td>" + files + "<a href=\"" + d +
          "/scan.json\">scan.json</a></td></tr>\n";
 }

@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "batch/pool.hpp"
+#include "picture/overview.hpp"
+#include "run/overview.hpp"
 
 namespace groovetrace::batch {
 namespace {
@@ -76,6 +78,8 @@ std::vector<std::pair<std::string, std::string>> run_files(const ScanJob& job, c
   result.timings_ms.insert(result.timings_ms.begin(), {"load", load_ms});
   if (!backend.warning().empty()) result.warnings.insert(result.warnings.begin(), backend.warning());
   auto files = render_outputs(cloud, result, p, job.path, ms_since(t0));
+  files.emplace_back("thumbnail.png", run_overview_png(cloud, result, p, job.path,
+                                                       picture::kThumbnailSide));
   fill_counts(row, cloud, result);
   return files;
 }

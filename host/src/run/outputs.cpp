@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "picture/overview.hpp"
+#include "run/overview.hpp"
 
 namespace groovetrace {
 namespace {
@@ -126,9 +127,11 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   return report.dump(2) + "\n";
 }
 
+}  // namespace
+
 // overview.png, drawn in the scan's frame: trajectories moved into the base are moved back.
-std::string overview_png(const Cloud& input, const RunResult& result, const Params& params,
-                         const std::string& input_path) {
+std::string run_overview_png(const Cloud& input, const RunResult& result, const Params& params,
+                             const std::string& input_path, int max_side) {
   picture::OverviewInput in(input, result.groove, result.trajectories);
   if (result.T_base_camera) in.T_cloud_trajectory = result.T_base_camera->inverse();
   in.viewpoint = params.viewpoint;
@@ -137,10 +140,8 @@ std::string overview_png(const Cloud& input, const RunResult& result, const Para
       n == 0 ? "ok" : std::to_string(n) + (n == 1 ? " warning" : " warnings");
   in.caption = picture::caption_line(std::filesystem::path(input_path).filename().string(),
                                      to_string(result.method), result.trajectories, status);
-  return picture::overview_png(in);
+  return picture::overview_png(in, max_side);
 }
-
-}  // namespace
 
 std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& input,
                                                                 const RunResult& result,
@@ -154,7 +155,7 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
   ann.descriptor = &result.score;
   ann.groove = &result.groove;
   files.emplace_back("annotated.pcd", annotated_pcd_bytes(input, ann));
-  files.emplace_back("overview.png", overview_png(input, result, params, input_path));
+  files.emplace_back("overview.png", run_overview_png(input, result, params, input_path, 0));
   for (std::size_t k = 0; k < result.trajectories.size(); ++k) {
     const std::string n = k == 0 ? "" : "_" + std::to_string(k);
     const Trajectory& t = result.trajectories[k];
