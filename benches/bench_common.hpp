@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <groovetrace/paper.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
+#include <groovetrace/paper.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <map>
 #include <memory>

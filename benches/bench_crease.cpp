@@ -13,7 +13,8 @@
 namespace bench {
 namespace {
 
-// The robust method's settings (host/src/robust/candidates.cpp): 10 mm, 3 mm, 80th percentile, 31 voxels.
+// The robust method's settings (host/src/robust/candidates.cpp): 10 mm, 3 mm, 80th percentile, 31
+// voxels.
 CreaseParams crease_params() {
   CreaseParams p;
   p.min_neighbors = 31;

@@ -96,8 +96,7 @@ void BM_RunPcl(benchmark::State& state) {
     }
     r.trajectories.push_back(paper_trajectory(cloud, r.normals, largest, pp.slices));
     r.backend = "pcl";
-    write_outputs((bench_dir() / "out-pcl").string(),
-                  render_outputs(cloud, r, params, path, 0.0));
+    write_outputs((bench_dir() / "out-pcl").string(), render_outputs(cloud, r, params, path, 0.0));
   }
   report_points(state, frame(state.range(0)).size());
 }

@@ -1,11 +1,10 @@
 // Uses groovetrace as a library: builds a small V-groove cloud in memory, runs the feature
 // backend and detection stages, and prints what was found. Exit 0 when a groove is found.
-#include <groovetrace/paper.hpp>
-#include <groovetrace/features.hpp>
-#include <groovetrace/pipeline.hpp>
-
 #include <cmath>
 #include <cstdio>
+#include <groovetrace/features.hpp>
+#include <groovetrace/paper.hpp>
+#include <groovetrace/pipeline.hpp>
 
 int main() {
   using namespace groovetrace;

@@ -53,10 +53,11 @@ BatchOptions options_of(const BatchCli& cli) {
 int run_batch_command(const BatchCli& cli) {
   const BatchOptions o = options_of(cli);
   const BatchTotals t = run_batch(o);
-  std::printf("groovetrace: batch: %zu scans (shard %d/%d), %zu ok, %zu failed, %zu kept from "
-              "before, %.2f frames/s; summary in %s/index.html\n",
-              t.scans, o.shard_index, o.shard_count, t.ok + (t.skipped), t.failed, t.skipped,
-              t.frames_per_second, o.out_dir.c_str());
+  std::printf(
+      "groovetrace: batch: %zu scans (shard %d/%d), %zu ok, %zu failed, %zu kept from "
+      "before, %.2f frames/s; summary in %s/index.html\n",
+      t.scans, o.shard_index, o.shard_count, t.ok + (t.skipped), t.failed, t.skipped,
+      t.frames_per_second, o.out_dir.c_str());
   return t.failed > 0 ? kSomeScansFailed : 0;
 }
 
@@ -67,9 +68,9 @@ Command add_batch_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("batch", "run every scan of folders, files or manifests");
   sub->add_option("inputs", cli->inputs, "folders (searched for .pcd/.ply), scans or manifest CSVs")
       ->required();
-  sub->add_option("-o,--output", cli->out_dir, "output directory (created if missing)")
-      ->required();
-  sub->add_flag("--resume", cli->resume, "keep scans already done with the same input and parameters");
+  sub->add_option("-o,--output", cli->out_dir, "output directory (created if missing)")->required();
+  sub->add_flag("--resume", cli->resume,
+                "keep scans already done with the same input and parameters");
   sub->add_option("--shard", cli->shard,
                   "K/N: every N-th scan from the K-th (default: SLURM_ARRAY_TASK_ID/COUNT)");
   sub->add_option("--shard-count", cli->shard_count, "N with JOB_COMPLETION_INDEX (Kubernetes)");

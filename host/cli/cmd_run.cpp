@@ -1,6 +1,7 @@
 // `groovetrace run SCAN -o OUTDIR`: the whole pipeline on one scan.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -9,7 +10,6 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
-#include <algorithm>
 #include <map>
 #include <memory>
 

@@ -4,14 +4,13 @@
 // main() turns those into one stderr line and the exit code.
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 
 namespace groovetrace::cli {
 
 struct Command {
-  CLI::App* app = nullptr;    ///< the subcommand (to know whether it was chosen)
-  std::function<int()> run;   ///< returns the exit code on success paths
+  CLI::App* app = nullptr;   ///< the subcommand (to know whether it was chosen)
+  std::function<int()> run;  ///< returns the exit code on success paths
 };
 
 Command add_run_command(CLI::App& app);

@@ -31,10 +31,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("groovetrace ") + groovetrace::version());
   app.require_subcommand(1);
   std::vector<groovetrace::cli::Command> commands = {
-      groovetrace::cli::add_run_command(app),
-      groovetrace::cli::add_synth_command(app),
-      groovetrace::cli::add_eval_command(app),
-      groovetrace::cli::add_batch_command(app),
+      groovetrace::cli::add_run_command(app),    groovetrace::cli::add_synth_command(app),
+      groovetrace::cli::add_eval_command(app),   groovetrace::cli::add_batch_command(app),
       groovetrace::cli::add_report_command(app),
   };
   try {

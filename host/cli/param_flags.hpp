@@ -3,7 +3,6 @@
 
 #include <CLI/CLI.hpp>
 #include <groovetrace/params.hpp>
-
 #include <map>
 #include <memory>
 #include <string>

@@ -1,7 +1,7 @@
 // CPU reference backend: normals, MLS and the GFH descriptor on analytic geometry.
 #include <gtest/gtest.h>
-#include <groovetrace/features.hpp>
 
+#include <groovetrace/features.hpp>
 #include <random>
 
 #include "support/scenes.hpp"

@@ -185,9 +185,9 @@ TEST(OpenClCrease, RobustRunsAgree) {
     EXPECT_EQ(got.device, cl->device());
     const auto& rw = ref.trajectories.front().waypoints;
     ASSERT_GE(rw.size(), 10u) << shape_name(shape);
-    EXPECT_LE(
-        std::abs(static_cast<long>(rw.size()) - static_cast<long>(got.trajectories.front().waypoints.size())),
-        1)
+    EXPECT_LE(std::abs(static_cast<long>(rw.size()) -
+                       static_cast<long>(got.trajectories.front().waypoints.size())),
+              1)
         << shape_name(shape);
     // Both ways: each path's waypoints against the other path.
     for (const auto& [from, to] : {std::pair(&ref, &got), std::pair(&got, &ref)}) {

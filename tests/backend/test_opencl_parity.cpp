@@ -210,7 +210,9 @@ TEST(OpenClParity, PaperTrajectoriesAgree) {
   ASSERT_EQ(ref.trajectories.front().waypoints.size(), got.trajectories.front().waypoints.size());
   ASSERT_GE(ref.trajectories.front().waypoints.size(), 10u);
   for (std::size_t k = 0; k < ref.trajectories.front().waypoints.size(); ++k) {
-    EXPECT_LT((ref.trajectories.front().waypoints[k].position - got.trajectories.front().waypoints[k].position).norm(),
+    EXPECT_LT((ref.trajectories.front().waypoints[k].position -
+               got.trajectories.front().waypoints[k].position)
+                  .norm(),
               1e-4)
         << "waypoint " << k;
   }

@@ -31,16 +31,16 @@ TEST(BatchJobs, FoldersAreSearchedSortedAndNamesNeverCollide) {
   const fs::path d = test::fresh_dir("batch_jobs_folders");
   touch(d / "in" / "b" / "scan.pcd");
   touch(d / "in" / "a" / "scan.pcd");
-  touch(d / "in" / "a" / "scan.PLY");        // same stem, other extension
-  touch(d / "in" / "a" / "notes.txt");       // not a scan
+  touch(d / "in" / "a" / "scan.PLY");   // same stem, other extension
+  touch(d / "in" / "a" / "notes.txt");  // not a scan
   touch(d / "in" / "a" / "s1.pcd");
-  touch(d / "in" / "a" / "s1.labels.pcd");   // synth's ground truth beside s1.truth.json
+  touch(d / "in" / "a" / "s1.labels.pcd");  // synth's ground truth beside s1.truth.json
   touch(d / "in" / "a" / "s1.truth.json");
-  touch(d / "in" / "a" / "x.labels.pcd");    // no truth beside it: a scan
-  touch(d / "other" / "a" / "s1.pcd");       // same relative path under a second input
+  touch(d / "in" / "a" / "x.labels.pcd");  // no truth beside it: a scan
+  touch(d / "other" / "a" / "s1.pcd");     // same relative path under a second input
   const auto jobs = list_jobs({(d / "in").string(), (d / "other").string()});
   EXPECT_EQ(rels(jobs), (std::vector<std::string>{"a/s1", "a/s1_2", "a/scan_pcd", "a/scan_ply",
-                                                   "a/x.labels", "b/scan"}));
+                                                  "a/x.labels", "b/scan"}));
   EXPECT_EQ(jobs[1].path, (d / "other" / "a" / "s1.pcd").string());
   EXPECT_THROW(list_jobs({(d / "missing").string()}), InputError);
   fs::create_directories(d / "nothing");

@@ -1,6 +1,7 @@
 // Every bad input to `groovetrace run`: one line on stderr, the documented exit code, and
 // no output file left behind.
 #include <gtest/gtest.h>
+
 #include <groovetrace/cloud_io.hpp>
 
 #include "support/cli_runner.hpp"
@@ -45,8 +46,7 @@ class BadInput : public ::testing::Test {
   fs::path dir_, out_;
 };
 
-std::string ascii_pcd(const std::string& fields, int width, int height,
-                      const std::string& data) {
+std::string ascii_pcd(const std::string& fields, int width, int height, const std::string& data) {
   std::string types, sizes, counts;
   std::stringstream ss(fields);
   std::string f;
@@ -89,9 +89,9 @@ TEST_F(BadInput, TruncatedBinaryPcd) {
 
 TEST_F(BadInput, TruncatedAsciiPcd) {
   // Header promises 200 points, 120 are there.
-  expect_failure(write("cut_ascii.pcd", ascii_pcd("x y z", 200, 1, rows(120, "0.1 0.2 0.5")))
-                     .string(),
-                 3, "cut_ascii.pcd");
+  expect_failure(
+      write("cut_ascii.pcd", ascii_pcd("x y z", 200, 1, rows(120, "0.1 0.2 0.5"))).string(), 3,
+      "cut_ascii.pcd");
 }
 
 TEST_F(BadInput, NoXyzFields) {
@@ -104,20 +104,20 @@ TEST_F(BadInput, EmptyCloud) {
 }
 
 TEST_F(BadInput, AllNaN) {
-  expect_failure(write("nan.pcd", ascii_pcd("x y z", 200, 1, rows(200, "nan nan nan"))).string(),
-                 3, "NaN");
+  expect_failure(write("nan.pcd", ascii_pcd("x y z", 200, 1, rows(200, "nan nan nan"))).string(), 3,
+                 "NaN");
 }
 
 TEST_F(BadInput, TooFewPoints) {
-  expect_failure(write("few.pcd", ascii_pcd("x y z", 20, 1, rows(20, "0.1 0.2 0.5"))).string(),
-                 3, "few.pcd");
+  expect_failure(write("few.pcd", ascii_pcd("x y z", 20, 1, rows(20, "0.1 0.2 0.5"))).string(), 3,
+                 "few.pcd");
 }
 
 TEST_F(BadInput, InfiniteValues) {
-  expect_failure(write("inf.pcd", ascii_pcd("x y z", 200, 1,
-                                            rows(199, "0.1 0.2 0.5") + "inf 0.2 0.5\n"))
-                     .string(),
-                 3, "infinite");
+  expect_failure(
+      write("inf.pcd", ascii_pcd("x y z", 200, 1, rows(199, "0.1 0.2 0.5") + "inf 0.2 0.5\n"))
+          .string(),
+      3, "infinite");
 }
 
 TEST_F(BadInput, NoGrooveOnAFlatPlate) {
@@ -133,8 +133,8 @@ TEST_F(BadInput, NoGrooveOnAFlatPlate) {
 TEST_F(BadInput, UnwritableOutputDirectory) {
   // A path below a regular file can never be created, even by root.
   const fs::path file = write("plainfile", "x");
-  const auto r = test::run_cli("run " + good_scan().string() + " -o " + (file / "out").string(),
-                               dir_);
+  const auto r =
+      test::run_cli("run " + good_scan().string() + " -o " + (file / "out").string(), dir_);
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("not a directory"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -180,12 +180,9 @@ TEST_F(BadInput, MissingArguments) {
 
 TEST_F(BadInput, BadConfigFiles) {
   const std::string scan = good_scan().string();
-  expect_failure(scan + " --config " + write("c1.yaml", "radius: [1, 2\n").string(), 3,
-                 "c1.yaml");
-  expect_failure(scan + " --config " + write("c2.yaml", "radiuss: 0.003\n").string(), 2,
-                 "radiuss");
-  expect_failure(scan + " --config " + write("c3.json", "{\"slices\": -4}").string(), 2,
-                 "slices");
+  expect_failure(scan + " --config " + write("c1.yaml", "radius: [1, 2\n").string(), 3, "c1.yaml");
+  expect_failure(scan + " --config " + write("c2.yaml", "radiuss: 0.003\n").string(), 2, "radiuss");
+  expect_failure(scan + " --config " + write("c3.json", "{\"slices\": -4}").string(), 2, "slices");
   expect_failure(scan + " --config " + (dir_ / "missing.yaml").string(), 3, "missing.yaml");
 }
 
@@ -195,9 +192,9 @@ TEST_F(BadInput, BadCalibrationFiles) {
   const fs::path skew = write("he.yaml", "translation: [0, 0, 0.1]\nrotation: [0, 0, 0.5, 1]\n");
   expect_failure(scan + " --hand-eye " + skew.string() + " --flange-pose " + good.string(), 3,
                  "unit");
-  expect_failure(scan + " --hand-eye " + (dir_ / "none.yaml").string() + " --flange-pose " +
-                     good.string(),
-                 3, "none.yaml");
+  expect_failure(
+      scan + " --hand-eye " + (dir_ / "none.yaml").string() + " --flange-pose " + good.string(), 3,
+      "none.yaml");
 }
 
 }  // namespace

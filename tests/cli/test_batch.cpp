@@ -51,7 +51,8 @@ std::string browser_dom(const fs::path& html, const fs::path& scratch, std::stri
   const fs::path profile = scratch / "chromium-profile";
   const auto r = test::run_cli_command(
       "chromium --headless --no-sandbox --disable-gpu --enable-logging=stderr --v=0 "
-      "--user-data-dir=" + profile.string() + " --dump-dom file://" + html.string(),
+      "--user-data-dir=" +
+          profile.string() + " --dump-dom file://" + html.string(),
       scratch);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   log = r.err;
@@ -84,19 +85,22 @@ class CliBatch : public ::testing::Test {
 TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   write_scan(in_ / "line1" / "a.pcd", 1);
   write_scan(in_ / "line1" / "b.pcd", 2);
-  write_scan(in_ / "line2" / "a.pcd", 3);           // same stem, other folder: no collision
-  write_scan(in_ / "line2" / "flat.pcd", 4, 0.0);   // no groove
-  write_scan(in_ / "line2" / "crash.pcd", 5);       // its worker raises SIGSEGV
+  write_scan(in_ / "line2" / "a.pcd", 3);          // same stem, other folder: no collision
+  write_scan(in_ / "line2" / "flat.pcd", 4, 0.0);  // no groove
+  write_scan(in_ / "line2" / "crash.pcd", 5);      // its worker raises SIGSEGV
   const std::string good = test::read_text(in_ / "line1" / "a.pcd");
   std::ofstream(in_ / "line2" / "truncated.pcd", std::ios::binary) << good.substr(0, 2000);
   std::ofstream(in_ / "line2" / "empty.pcd");
   const auto r = test::run_cli(batch("--jobs 2 --progress lines"), dir_,
                                "GROOVETRACE_TEST_CRASH_SCAN=crash.pcd");
   EXPECT_EQ(r.exit_code, 6) << r.err << r.out;  // docs/batch.md: some scan failed
-  const std::map<std::string, std::string> expected = {
-      {"line1/a", "ok"},       {"line1/b", "ok"},        {"line2/a", "ok"},
-      {"line2/flat", "no_groove"}, {"line2/crash", "crashed"}, {"line2/truncated", "invalid_input"},
-      {"line2/empty", "invalid_input"}};
+  const std::map<std::string, std::string> expected = {{"line1/a", "ok"},
+                                                       {"line1/b", "ok"},
+                                                       {"line2/a", "ok"},
+                                                       {"line2/flat", "no_groove"},
+                                                       {"line2/crash", "crashed"},
+                                                       {"line2/truncated", "invalid_input"},
+                                                       {"line2/empty", "invalid_input"}};
   EXPECT_EQ(statuses(dir_ / "out" / "summary.csv"), expected);
   // One progress line per scan, and the scans after the crash still ran.
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 7) << r.err;
@@ -124,7 +128,7 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   }
   EXPECT_NE(dom.find("7 scans"), std::string::npos);
   EXPECT_NE(dom.find("line1/a/thumbnail.png"), std::string::npos);  // the ok scans have pictures
-  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;  // script errors
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;        // script errors
   // Every picture the page shows is there (a broken image is no console error).
   for (auto at = dom.find("src=\""); at != std::string::npos; at = dom.find("src=\"", at + 1)) {
     const std::string src = dom.substr(at + 5, dom.find('"', at + 5) - at - 5);
@@ -153,7 +157,8 @@ TEST_F(CliBatch, HangingScanTimesOut) {
 // A kill -9 mid-batch loses at most the scans in flight; --resume redoes only those and the
 // ones not started, and reruns everything when a parameter changes.
 TEST_F(CliBatch, KilledBatchResumes) {
-  for (unsigned k = 0; k < 6; ++k) write_scan(in_ / "line1" / ("s" + std::to_string(k) + ".pcd"), k + 1);
+  for (unsigned k = 0; k < 6; ++k)
+    write_scan(in_ / "line1" / ("s" + std::to_string(k) + ".pcd"), k + 1);
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
@@ -183,7 +188,8 @@ TEST_F(CliBatch, KilledBatchResumes) {
   const auto r = test::run_cli(batch("--jobs 1 --resume --progress lines"), dir_);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(static_cast<std::size_t>(std::count(r.err.begin(), r.err.end(), '\n')),
-            6 - before.size()) << r.err;
+            6 - before.size())
+      << r.err;
   for (const auto& [path, text] : before) EXPECT_EQ(test::read_text(path), text) << path;
   EXPECT_EQ(count_files(dir_ / "out", "scan.json"), 6u);
   EXPECT_EQ(count_files(dir_ / "out", "trajectory.csv"), 6u);
@@ -202,13 +208,15 @@ TEST_F(CliBatch, BadUsageAndInputs) {
   EXPECT_EQ(test::run_cli(batch("--progress loud"), dir_).exit_code, 2);
   EXPECT_EQ(test::run_cli(batch("--scan-timeout 0"), dir_).exit_code, 2);
   EXPECT_EQ(test::run_cli(batch("--radius 3"), dir_).exit_code, 2);
-  const auto missing = test::run_cli("batch " + (dir_ / "nope").string() + " -o " +
-                                         (dir_ / "out").string(), dir_);
+  const auto missing =
+      test::run_cli("batch " + (dir_ / "nope").string() + " -o " + (dir_ / "out").string(), dir_);
   EXPECT_EQ(missing.exit_code, 3);
   EXPECT_NE(missing.err.find("does not exist"), std::string::npos) << missing.err;
   fs::create_directories(dir_ / "empty_dir");
-  EXPECT_EQ(test::run_cli("batch " + (dir_ / "empty_dir").string() + " -o " +
-                              (dir_ / "out").string(), dir_).exit_code, 3);
+  EXPECT_EQ(test::run_cli(
+                "batch " + (dir_ / "empty_dir").string() + " -o " + (dir_ / "out").string(), dir_)
+                .exit_code,
+            3);
   EXPECT_EQ(test::run_cli("report " + (dir_ / "empty_dir").string(), dir_).exit_code, 3);
   EXPECT_FALSE(fs::exists(dir_ / "out")) << "a refused batch writes nothing";
 }

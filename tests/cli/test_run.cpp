@@ -1,7 +1,7 @@
 // `groovetrace run` end to end on a rendered 640x480 V-groove with known geometry.
 #include <gtest/gtest.h>
-#include <groovetrace/cloud_io.hpp>
 
+#include <groovetrace/cloud_io.hpp>
 #include <nlohmann/json.hpp>
 
 #include "support/cli_runner.hpp"
@@ -29,7 +29,8 @@ std::vector<CsvPose> read_trajectory_csv(const fs::path& path) {
     std::vector<double> v;
     while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
     EXPECT_EQ(v.size(), 11u);
-    poses.push_back({Eigen::Vector3d(v[1], v[2], v[3]), Eigen::Quaterniond(v[7], v[4], v[5], v[6])});
+    poses.push_back(
+        {Eigen::Vector3d(v[1], v[2], v[3]), Eigen::Quaterniond(v[7], v[4], v[5], v[6])});
   }
   return poses;
 }
@@ -67,7 +68,8 @@ TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   // compare with the groove's centre line at half depth (2 mm tolerance, the bound),
   // and require the lateral offset alone to be small.
   const Eigen::Vector3d dir = scene_.groove_dir_camera;
-  const Eigen::Vector3d mid = scene_.root_point_camera + scene_.up_camera * (scene_params_.depth / 2);
+  const Eigen::Vector3d mid =
+      scene_.root_point_camera + scene_.up_camera * (scene_params_.depth / 2);
   const auto poses = read_trajectory_csv(out / "trajectory.csv");
   ASSERT_EQ(poses.size(), 50u);
   double max_dist = 0, max_lateral = 0;
@@ -104,7 +106,8 @@ TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   const std::string script = test::read_text(out / "program.script");
   EXPECT_NE(script.find("def weld_seam():"), std::string::npos);
   std::size_t moves = 0;
-  for (auto at = script.find("movep("); at != std::string::npos; at = script.find("movep(", at + 1)) {
+  for (auto at = script.find("movep("); at != std::string::npos;
+       at = script.find("movep(", at + 1)) {
     ++moves;
   }
   EXPECT_EQ(moves, poses.size() - 1);  // every waypoint after the first is a movep
@@ -120,7 +123,7 @@ TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "");  // --quiet
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
-  EXPECT_EQ(report["parameters"]["slices"], 30);                     // flag wins
+  EXPECT_EQ(report["parameters"]["slices"], 30);                           // flag wins
   EXPECT_DOUBLE_EQ(report["parameters"]["threshold"].get<double>(), 6.0);  // from config
   EXPECT_DOUBLE_EQ(report["parameters"]["weld_speed"].get<double>(), 0.01);
   EXPECT_EQ(read_trajectory_csv(out / "trajectory.csv").size(), 30u);
@@ -128,9 +131,9 @@ TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
 
 TEST_F(CliRun, AutoThresholdFindsTheGroove) {
   const fs::path out = dir_ / "out_auto";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --method paper --threshold auto --backend cpu",
-      dir_);
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() +
+                                   " --method paper --threshold auto --backend cpu",
+                               dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
   EXPECT_EQ(report["detection"]["threshold_mode"], "otsu_log_descriptor");

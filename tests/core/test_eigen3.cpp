@@ -1,10 +1,11 @@
 // The analytic 3x3 eigen-solver against Eigen's iterative SelfAdjointEigenSolver.
 #include <gtest/gtest.h>
-#include "core/eigen3.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <random>
+
+#include "core/eigen3.hpp"
 
 namespace groovetrace {
 namespace {
@@ -79,8 +80,8 @@ TEST(Eigen3, DegenerateMatrices) {
 TEST(Eigen3, RotatedDegenerateMatrices) {
   std::mt19937 rng(3);
   std::normal_distribution<double> g(0, 1);
-  const std::vector<Eigen::Vector3d> spectra = {
-      {1, 1, 1}, {0, 1, 1}, {0, 0, 1}, {2, 2, 5}, {1e-8, 1, 1}, {0, 0, 0}};
+  const std::vector<Eigen::Vector3d> spectra = {{1, 1, 1}, {0, 1, 1},    {0, 0, 1},
+                                                {2, 2, 5}, {1e-8, 1, 1}, {0, 0, 0}};
   for (const auto& s : spectra) {
     for (int t = 0; t < 100; ++t) {
       const Eigen::Matrix3d r =

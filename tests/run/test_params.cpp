@@ -1,10 +1,10 @@
 // The parameter table: each key writes its own method's field, reports the other method's
 // keys, and round-trips through report.json's text.
 #include <gtest/gtest.h>
+
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
-
 #include <nlohmann/json.hpp>
 #include <set>
 

@@ -2,10 +2,9 @@
 // Analytic test scenes: a pinhole camera (RealSense-like intrinsics) looking at a plate with
 // a straight V-groove, ray-cast exactly so that tests know the true geometry.
 
-#include <groovetrace/cloud.hpp>
-
 #include <Eigen/Geometry>
 #include <cmath>
+#include <groovetrace/cloud.hpp>
 #include <random>
 #include <vector>
 
@@ -13,12 +12,12 @@ namespace groovetrace::test {
 
 struct VGrooveScene {
   int width = 640, height = 480;
-  double distance = 0.4;       // camera to plate along the optical axis at zero tilt (m)
-  double tilt_deg = 0.0;       // camera rotation about the world x axis (across the groove)
-  double yaw_deg = 0.0;        // camera rotation about the plate normal (turns the groove)
-  double top_width = 0.010;    // groove opening (m)
-  double depth = 0.004;        // groove depth below the plate (m)
-  double noise_sigma = 0.0;    // Gaussian depth noise along the ray (m)
+  double distance = 0.4;     // camera to plate along the optical axis at zero tilt (m)
+  double tilt_deg = 0.0;     // camera rotation about the world x axis (across the groove)
+  double yaw_deg = 0.0;      // camera rotation about the plate normal (turns the groove)
+  double top_width = 0.010;  // groove opening (m)
+  double depth = 0.004;      // groove depth below the plate (m)
+  double noise_sigma = 0.0;  // Gaussian depth noise along the ray (m)
   unsigned seed = 1;
 };
 
@@ -26,9 +25,9 @@ struct RenderedScene {
   Cloud cloud;                      // camera frame, metres
   std::vector<std::uint8_t> label;  // 1 = on a groove wall
   Eigen::Isometry3d T_world_camera;
-  Eigen::Vector3d groove_dir_camera;    // unit direction of the groove (camera frame)
-  Eigen::Vector3d root_point_camera;    // a point on the root line (camera frame)
-  Eigen::Vector3d up_camera;            // plate normal (towards the camera), camera frame
+  Eigen::Vector3d groove_dir_camera;  // unit direction of the groove (camera frame)
+  Eigen::Vector3d root_point_camera;  // a point on the root line (camera frame)
+  Eigen::Vector3d up_camera;          // plate normal (towards the camera), camera frame
 };
 
 // World frame: plate top at z = 0, +z towards the camera, groove along world y centred on

@@ -2,10 +2,9 @@
 // `groovetrace batch`: many stored scans through `run`, in worker processes that survive bad
 // scans, with a resumable output tree and a summary of the night (docs/batch.md).
 
+#include <cstddef>
 #include <groovetrace/export.hpp>
 #include <groovetrace/params.hpp>
-
-#include <cstddef>
 #include <string>
 #include <vector>
 

@@ -1,11 +1,11 @@
 #pragma once
 // A point cloud as plain structure-of-arrays data, the unit every stage consumes.
 
-#include <groovetrace/export.hpp>
 #include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <groovetrace/export.hpp>
 #include <vector>
 
 namespace groovetrace {

@@ -1,10 +1,9 @@
 #pragma once
 // Reading scans (PCD, PLY) and writing the annotated cloud.
 
-#include <groovetrace/export.hpp>
-#include <groovetrace/cloud.hpp>
-
 #include <cstdint>
+#include <groovetrace/cloud.hpp>
+#include <groovetrace/export.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,8 +28,8 @@ GT_API Cloud read_cloud(const std::string& path, const ReadOptions& options = {}
 
 /// Per-point annotations written beside the input points.
 struct Annotations {
-  const Normals* normals = nullptr;                  ///< cloud frame, unit, NaN = none
-  const std::vector<float>* descriptor = nullptr;    ///< D (deg^2), NaN = none
+  const Normals* normals = nullptr;                   ///< cloud frame, unit, NaN = none
+  const std::vector<float>* descriptor = nullptr;     ///< D (deg^2), NaN = none
   const std::vector<std::uint8_t>* groove = nullptr;  ///< 1 = groove
 };
 

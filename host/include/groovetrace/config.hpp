@@ -3,9 +3,8 @@
 // so a parameter is declared once. Keys are snake_case; the flag is the key with dashes
 // (`mls_radius` <-> `--mls-radius`). All lengths are metres whatever `--units` says.
 
-#include <groovetrace/params.hpp>
-
 #include <functional>
+#include <groovetrace/params.hpp>
 #include <string>
 #include <vector>
 

@@ -7,7 +7,8 @@
 
 namespace groovetrace {
 
-/// Exit codes of the CLI (docs/design.md, "CLI contract"): 0 ok, 2 bad usage, 3 bad input, 4 no groove, 5 internal.
+/// Exit codes of the CLI (docs/design.md, "CLI contract"): 0 ok, 2 bad usage, 3 bad input, 4 no
+/// groove, 5 internal.
 enum class ExitCode : int { kOk = 0, kUsage = 2, kInput = 3, kNoGroove = 4, kInternal = 5 };
 
 /// Base of every error groovetrace throws on purpose; what() is one line, fit for stderr.

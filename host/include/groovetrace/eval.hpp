@@ -6,9 +6,9 @@
 // Frames: everything is compared in the scan's camera frame (metres). A trajectory written in
 // the robot base frame (`run --hand-eye ...`) cannot be compared; evaluate_files notes it.
 
-#include <groovetrace/export.hpp>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <groovetrace/export.hpp>
 #include <groovetrace/synth.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <string>
@@ -76,7 +76,7 @@ struct EvalMetrics {
 /// truth's point order; `poses` are in the camera frame, in travel order. Throws InputError if
 /// `detected` does not match the truth's point count.
 GT_API EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
-                     const std::vector<ToolPose>& poses, const EvalOptions& options = {});
+                            const std::vector<ToolPose>& poses, const EvalOptions& options = {});
 
 /// What evaluate_files reads from a `groovetrace run` output directory.
 struct RunOutput {
@@ -96,11 +96,11 @@ GT_API RunOutput read_run_output(const std::string& result_dir);
 
 /// Reads the truth of `scan_path` (read_synth_truth) and the run output, and evaluates.
 GT_API EvalMetrics evaluate_files(const std::string& scan_path, const std::string& result_dir,
-                           const EvalOptions& options = {});
+                                  const EvalOptions& options = {});
 
 /// metrics.json contents (metres and degrees; NaN as null). `truth` and `result` are recorded.
 GT_API std::string metrics_json(const EvalMetrics& metrics, const std::string& truth,
-                         const std::string& result);
+                                const std::string& result);
 /// A short human summary (millimetres), several lines.
 GT_API std::string metrics_summary(const EvalMetrics& metrics);
 

@@ -2,8 +2,8 @@
 // The per-point work (smoothing, normals, groove descriptor) behind one interface, so the
 // OpenCL kernels and the CPU reference are interchangeable and checked against each other.
 
-#include <groovetrace/export.hpp>
 #include <groovetrace/cloud.hpp>
+#include <groovetrace/export.hpp>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,7 +92,7 @@ GT_API Eigen::Vector3f benchmark_normal(const Normals& normals);
 /// the first GPU, else the first device. Throws UsageError for an unknown name or a device
 /// that matches nothing, OpenClError (an InternalError) when "opencl" cannot run.
 GT_API std::unique_ptr<FeatureBackend> make_backend(const std::string& name,
-                                             const std::string& device = "");
+                                                    const std::string& device = "");
 
 /// The CPU reference backend (OpenMP + Eigen).
 GT_API std::unique_ptr<FeatureBackend> make_cpu_backend();

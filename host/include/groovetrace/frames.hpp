@@ -1,10 +1,9 @@
 #pragma once
 // Rigid transforms from calibration files, and moving a trajectory into the robot base.
 
+#include <Eigen/Geometry>
 #include <groovetrace/export.hpp>
 #include <groovetrace/trajectory.hpp>
-
-#include <Eigen/Geometry>
 #include <string>
 
 namespace groovetrace {

@@ -7,9 +7,9 @@
 // GROOVETRACE_OPENCL_VW=1|2|4|8|16 sets the queries per work-item (default 16 on CPU devices,
 // 1 on GPUs); GROOVETRACE_OPENCL_OPTIONS adds OpenCL compiler options.
 
-#include <groovetrace/export.hpp>
 #include <cstdint>
 #include <groovetrace/error.hpp>
+#include <groovetrace/export.hpp>
 #include <groovetrace/features.hpp>
 #include <memory>
 #include <string>

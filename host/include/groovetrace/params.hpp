@@ -22,16 +22,16 @@ GT_API const char* to_string(Method method);
 
 /// The paper method's own parameters (`--method paper`).
 struct PaperParams {
-  bool smooth = true;          ///< run MLS smoothing before normals
-  double mls_radius = 0.003;   ///< MLS search radius (m)
-  int mls_order = 2;           ///< MLS polynomial order: 1 = plane projection, 2 = quadric
-  double radius = 0.003;       ///< neighbourhood radius r for normals and the GFH (m)
-  int min_neighbors = 5;       ///< fewer neighbours within r: no normal, never groove
-  bool threshold_auto = false; ///< Otsu on log(D) instead of a fixed threshold
-  double threshold = 4.5;      ///< descriptor threshold (deg^2); paper range 4.5-5
-  int min_component = 50;      ///< connected groove parts smaller than this are dropped (points)
-  double link_distance = 0.0;  ///< max gap inside one groove component (m); 0 = radius
-  int slices = 50;             ///< equal-width slices along the groove = waypoints
+  bool smooth = true;           ///< run MLS smoothing before normals
+  double mls_radius = 0.003;    ///< MLS search radius (m)
+  int mls_order = 2;            ///< MLS polynomial order: 1 = plane projection, 2 = quadric
+  double radius = 0.003;        ///< neighbourhood radius r for normals and the GFH (m)
+  int min_neighbors = 5;        ///< fewer neighbours within r: no normal, never groove
+  bool threshold_auto = false;  ///< Otsu on log(D) instead of a fixed threshold
+  double threshold = 4.5;       ///< descriptor threshold (deg^2); paper range 4.5-5
+  int min_component = 50;       ///< connected groove parts smaller than this are dropped (points)
+  double link_distance = 0.0;   ///< max gap inside one groove component (m); 0 = radius
+  int slices = 50;              ///< equal-width slices along the groove = waypoints
   int median_max_iterations = 1000;
   double median_tolerance = 1e-7;  ///< Weiszfeld stop: step below this (m), the paper's 1e-4 mm
 };
@@ -70,8 +70,8 @@ struct ProgramParams {
 struct Params {
   Method method = Method::robust;
   std::string backend = "auto";  ///< "auto", "cpu" or "opencl"
-  std::string device;            ///< OpenCL device: index or name part; empty = first GPU, else first
-  double units_scale = 1.0;      ///< input coordinates * units_scale = metres (mm: 0.001)
+  std::string device;        ///< OpenCL device: index or name part; empty = first GPU, else first
+  double units_scale = 1.0;  ///< input coordinates * units_scale = metres (mm: 0.001)
   std::optional<Eigen::Vector3f> viewpoint;  ///< overrides the PCD VIEWPOINT (cloud frame, m)
 
   PaperParams paper;
@@ -79,8 +79,8 @@ struct Params {
   ProgramParams program;
 
   // Frames: robot base frame output when both are given (files, see docs/frames.md).
-  std::string hand_eye_file;      ///< T_flange_camera
-  std::string flange_pose_file;   ///< T_base_flange at capture time
+  std::string hand_eye_file;     ///< T_flange_camera
+  std::string flange_pose_file;  ///< T_base_flange at capture time
 };
 
 }  // namespace groovetrace

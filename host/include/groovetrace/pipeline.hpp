@@ -2,6 +2,8 @@
 // The whole `run`: the chosen method's detection, the trajectories, frames, and the output
 // files. Every 3-D quantity is in metres; per-point vectors are in input order.
 
+#include <cstdint>
+#include <functional>
 #include <groovetrace/cloud.hpp>
 #include <groovetrace/export.hpp>
 #include <groovetrace/features.hpp>
@@ -10,9 +12,6 @@
 #include <groovetrace/robust.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <groovetrace/version.hpp>
-
-#include <cstdint>
-#include <functional>
 #include <optional>
 #include <string>
 #include <utility>

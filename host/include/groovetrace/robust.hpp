@@ -7,11 +7,11 @@
 //
 // Frames and units: every 3-D quantity is in the cloud's frame, metres; angles in degrees.
 
-#include <groovetrace/export.hpp>
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <groovetrace/cloud.hpp>
+#include <groovetrace/export.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
@@ -96,9 +96,9 @@ struct RobustDetection {
 /// is called after each stage with its name ("candidates", "seams", "region"). The crease
 /// measure runs on `backend`; the rest, and everything without a backend, on the CPU.
 GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
-                              FeatureBackend& backend,
-                              const std::function<void(const std::string&)>& lap = {});
+                                     FeatureBackend& backend,
+                                     const std::function<void(const std::string&)>& lap = {});
 GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
-                              const std::function<void(const std::string&)>& lap = {});
+                                     const std::function<void(const std::string&)>& lap = {});
 
 }  // namespace groovetrace

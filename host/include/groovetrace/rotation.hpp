@@ -1,8 +1,8 @@
 #pragma once
 // Rotation representations for robot programs: the UR rotation vector (axis * angle).
 
-#include <groovetrace/export.hpp>
 #include <Eigen/Geometry>
+#include <groovetrace/export.hpp>
 
 namespace groovetrace {
 
@@ -13,7 +13,7 @@ GT_API Eigen::Vector3d rotation_vector(const Eigen::Quaterniond& q);
 /// (axis*angle and axis*(angle - 2 pi) for both signs of the axis). Keeps a path's vectors
 /// continuous where the angle passes pi, which UR controllers need to interpolate sanely.
 GT_API Eigen::Vector3d rotation_vector_near(const Eigen::Quaterniond& q,
-                                     const Eigen::Vector3d& previous);
+                                            const Eigen::Vector3d& previous);
 
 /// Quaternion of an axis-angle vector (rad).
 GT_API Eigen::Quaterniond quaternion_from_rotation_vector(const Eigen::Vector3d& v);

@@ -11,10 +11,10 @@
 // left imager's centre; the right imager sits at (+baseline, 0, 0). `T_workpiece_camera`
 // maps camera coordinates to workpiece coordinates: p_workpiece = T_workpiece_camera * p_camera.
 
-#include <groovetrace/export.hpp>
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <groovetrace/cloud.hpp>
+#include <groovetrace/export.hpp>
 #include <string>
 #include <vector>
 

@@ -1,11 +1,10 @@
 #pragma once
 // Torch poses and paths, shared by both methods and by every writer of robot programs.
 
-#include <groovetrace/export.hpp>
-#include <groovetrace/cloud.hpp>
-
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <groovetrace/cloud.hpp>
+#include <groovetrace/export.hpp>
 #include <string>
 #include <vector>
 
@@ -27,7 +26,7 @@ struct Waypoint {
 
 /// An ordered torch path.
 struct Trajectory {
-  std::string frame = "camera";       ///< "camera" (the scan's frame) or "base"
+  std::string frame = "camera";  ///< "camera" (the scan's frame) or "base"
   /// Unit overall travel direction: paper: the groove points' first principal axis; robust:
   /// the chord from the first to the last waypoint.
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
@@ -40,7 +39,7 @@ struct Trajectory {
 /// the surface normal or the walls' bisector) and the travel direction t: z = -n, x = t made
 /// orthogonal to z.
 GT_API Eigen::Quaterniond tool_orientation(const Eigen::Vector3d& normal,
-                                    const Eigen::Vector3d& travel);
+                                           const Eigen::Vector3d& travel);
 
 /// Fills rotation_vector (continuous along the path) and euler_zyx_deg from orientation.
 GT_API void fill_rotation_representations(Trajectory& trajectory);

@@ -4,7 +4,6 @@
 #include <groovetrace/export.hpp>
 #include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
-
 #include <string>
 
 namespace groovetrace {

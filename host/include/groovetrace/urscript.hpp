@@ -3,7 +3,6 @@
 
 #include <groovetrace/params.hpp>
 #include <groovetrace/trajectory.hpp>
-
 #include <string>
 
 namespace groovetrace {

@@ -39,7 +39,8 @@ class Progress {
                    row.dir.c_str(), row.status.c_str(), row.total_ms / 1000,
                    row.status == "ok" ? "" : ": ", row.status == "ok" ? "" : row.message.c_str());
     } else if (mode_ == BatchProgress::bar) {
-      const int width = 30, filled = static_cast<int>(width * done_ / std::max<std::size_t>(total_, 1));
+      const int width = 30,
+                filled = static_cast<int>(width * done_ / std::max<std::size_t>(total_, 1));
       const double eta = fps > 0 ? (total_ - done_) / fps : 0;
       std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.2f frames/s  ETA %d:%02d ",
                    std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),

@@ -29,8 +29,8 @@ bool is_scan(const fs::path& p) {
 bool is_synth_labels(const fs::path& p) {
   const std::string name = p.filename().string();
   const std::string suffix = ".labels.pcd";
-  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(),
-                                                   suffix) != 0) {
+  if (name.size() <= suffix.size() ||
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
     return false;
   }
   const std::string stem = name.substr(0, name.size() - suffix.size());
@@ -128,9 +128,9 @@ std::vector<ScanJob> read_manifest(const std::string& path) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::vector<std::string> row = csv_cells(line);
     const std::string where = "manifest " + path + " line " + std::to_string(n);
-    if (row.size() != header.size()) throw InputError(where + ": " + std::to_string(row.size()) +
-                                                      " cells, the header has " +
-                                                      std::to_string(header.size()));
+    if (row.size() != header.size())
+      throw InputError(where + ": " + std::to_string(row.size()) + " cells, the header has " +
+                       std::to_string(header.size()));
     ScanJob job{file(row, "scan"), without_extension(row[column["scan"]]), file(row, "flange_pose"),
                 file(row, "hand_eye"), std::nullopt};
     if (job.path.empty()) throw InputError(where + ": no scan");

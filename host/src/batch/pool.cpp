@@ -29,7 +29,7 @@ struct Worker {
   int to = -1, from = -1;  // our ends of its job pipe and its result pipe
   long job = -1;           // the job it runs, -1 when idle
   Clock::time_point start;
-  std::string pending;     // result bytes not yet ending in a newline
+  std::string pending;  // result bytes not yet ending in a newline
 };
 
 std::string host_name() {

@@ -20,11 +20,20 @@ std::string html_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -83,9 +92,9 @@ std::string totals_html(const std::vector<ScanRow>& rows, const RunStats& stats)
     summed_ms += r.total_ms;
   }
   std::string s = "<p class=\"totals\"><span>" + std::to_string(rows.size()) + " scans</span>" +
-                  "<span class=\"ok\">" + std::to_string(ok) + " ok</span>" +
-                  "<span class=\"" + (ok == rows.size() ? "ok" : "bad") + "\">" +
-                  std::to_string(rows.size() - ok) + " failed</span>";
+                  "<span class=\"ok\">" + std::to_string(ok) + " ok</span>" + "<span class=\"" +
+                  (ok == rows.size() ? "ok" : "bad") + "\">" + std::to_string(rows.size() - ok) +
+                  " failed</span>";
   if (stats.seconds > 0) {
     s += "<span>" + fmt("%.2f", stats.scans_run / stats.seconds) + " frames/s (" +
          std::to_string(stats.scans_run) + " scans in " + fmt("%.1f", stats.seconds) + " s, " +
@@ -129,9 +138,8 @@ std::string scan_row_html(const ScanRow& r, const std::string& out_dir) {
                       : std::string("")) +
          "</td><td>" + html_escape(r.dir) + "<br><small>" + html_escape(r.scan) +
          "</small></td><td class=\"" + (r.status == "ok" ? "ok" : "bad") + "\">" + r.status +
-         "</td><td>" + result_cell(r) + "</td><td>" +
-         fmt("%.0f", r.total_ms) + " ms</td><td>" + files + "<a href=\"" + d +
-         "/scan.json\">scan.json</a></td></tr>\n";
+         "</td><td>" + result_cell(r) + "</td><td>" + fmt("%.0f", r.total_ms) + " ms</td><td>" +
+         files + "<a href=\"" + d + "/scan.json\">scan.json</a></td></tr>\n";
 }
 
 }  // namespace
@@ -158,15 +166,16 @@ std::vector<ScanRow> collect_rows(const std::string& out_dir) {
 
 std::string index_html(const std::vector<ScanRow>& rows, const RunStats& stats,
                        const std::string& out_dir) {
-  std::string s = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-                  "<title>groovetrace batch</title><style>" +
-                  std::string(kStyle) + "</style></head><body>\n<h1>groovetrace batch</h1>\n" +
-                  totals_html(rows, stats) +
-                  "<p><a href=\"summary.csv\">summary.csv</a> <a href=\"summary.json\">"
-                  "summary.json</a></p>\n" +
-                  failures_html(rows) +
-                  "<h2>Scans</h2><table id=\"scans\"><tr><th></th><th>scan</th><th>status</th>"
-                  "<th>result</th><th>time</th><th>files</th></tr>\n";
+  std::string s =
+      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+      "<title>groovetrace batch</title><style>" +
+      std::string(kStyle) + "</style></head><body>\n<h1>groovetrace batch</h1>\n" +
+      totals_html(rows, stats) +
+      "<p><a href=\"summary.csv\">summary.csv</a> <a href=\"summary.json\">"
+      "summary.json</a></p>\n" +
+      failures_html(rows) +
+      "<h2>Scans</h2><table id=\"scans\"><tr><th></th><th>scan</th><th>status</th>"
+      "<th>result</th><th>time</th><th>files</th></tr>\n";
   for (const ScanRow& r : rows) s += scan_row_html(r, out_dir);
   return s + "</table>\n<p><small>groovetrace " + version() + "</small></p></body></html>\n";
 }

@@ -28,14 +28,22 @@ std::string number(double v) {
 std::string row_json(const ScanRow& r) {
   json stages = json::array();
   for (const auto& [name, ms] : r.stages_ms) stages.push_back({name, ms});
-  const json j = {{"scan", r.scan},           {"dir", r.dir},
-                  {"status", r.status},       {"exit_code", r.exit_code},
-                  {"message", r.message},     {"points", r.points},
-                  {"valid_points", r.valid_points}, {"groove_points", r.groove_points},
-                  {"seams", r.seams},         {"exported", r.exported},
-                  {"waypoints", r.waypoints}, {"length_m", r.length_m},
-                  {"stages_ms", stages},      {"total_ms", r.total_ms},
-                  {"input_hash", r.input_hash}, {"params_hash", r.params_hash}};
+  const json j = {{"scan", r.scan},
+                  {"dir", r.dir},
+                  {"status", r.status},
+                  {"exit_code", r.exit_code},
+                  {"message", r.message},
+                  {"points", r.points},
+                  {"valid_points", r.valid_points},
+                  {"groove_points", r.groove_points},
+                  {"seams", r.seams},
+                  {"exported", r.exported},
+                  {"waypoints", r.waypoints},
+                  {"length_m", r.length_m},
+                  {"stages_ms", stages},
+                  {"total_ms", r.total_ms},
+                  {"input_hash", r.input_hash},
+                  {"params_hash", r.params_hash}};
   return j.dump(2) + "\n";
 }
 
@@ -78,12 +86,11 @@ std::string csv_line(const ScanRow& r) {
     stages += (stages.empty() ? "" : ";") + name + "=" + number(ms);
   }
   return csv_cell(r.scan) + "," + csv_cell(r.dir) + "," + r.status + "," +
-         std::to_string(r.exit_code) + "," + csv_cell(r.message) + "," +
-         std::to_string(r.points) + "," + std::to_string(r.valid_points) + "," +
-         std::to_string(r.groove_points) + "," + std::to_string(r.seams) + "," +
-         std::to_string(r.exported) + "," + std::to_string(r.waypoints) + "," +
-         number(r.length_m) + "," + number(r.total_ms) + "," + csv_cell(stages) + "," +
-         r.input_hash + "," + r.params_hash + "\n";
+         std::to_string(r.exit_code) + "," + csv_cell(r.message) + "," + std::to_string(r.points) +
+         "," + std::to_string(r.valid_points) + "," + std::to_string(r.groove_points) + "," +
+         std::to_string(r.seams) + "," + std::to_string(r.exported) + "," +
+         std::to_string(r.waypoints) + "," + number(r.length_m) + "," + number(r.total_ms) + "," +
+         csv_cell(stages) + "," + r.input_hash + "," + r.params_hash + "\n";
 }
 
 std::uint64_t fnv1a64(const std::string& bytes, std::uint64_t seed) {

@@ -13,20 +13,20 @@ namespace groovetrace::batch {
 /// What happened to one scan. `status` is one of ok, no_groove, invalid_input, error, crashed,
 /// timeout.
 struct ScanRow {
-  std::string scan;     ///< the input file
-  std::string dir;      ///< its directory, relative to OUTDIR
+  std::string scan;  ///< the input file
+  std::string dir;   ///< its directory, relative to OUTDIR
   std::string status;
   int exit_code = 0;    ///< the exit code `run` gives for this outcome (crashed: -signal)
   std::string message;  ///< the one-line error, or the first warning, "" when none
   std::size_t points = 0, valid_points = 0, groove_points = 0;
-  int seams = 0;                 ///< accepted seams (robust) or kept parts (paper)
-  int exported = 0;              ///< trajectories written
-  std::size_t waypoints = 0;     ///< of the best trajectory
-  double length_m = 0;           ///< of the best trajectory (m)
+  int seams = 0;              ///< accepted seams (robust) or kept parts (paper)
+  int exported = 0;           ///< trajectories written
+  std::size_t waypoints = 0;  ///< of the best trajectory
+  double length_m = 0;        ///< of the best trajectory (m)
   std::vector<std::pair<std::string, double>> stages_ms;  ///< load, the method's stages, write
-  double total_ms = 0;           ///< the scan's wall time in its worker (ms)
-  std::string input_hash;        ///< FNV-1a 64 of the input file's bytes, hex
-  std::string params_hash;       ///< FNV-1a 64 of the parameters as report.json lists them, hex
+  double total_ms = 0;      ///< the scan's wall time in its worker (ms)
+  std::string input_hash;   ///< FNV-1a 64 of the input file's bytes, hex
+  std::string params_hash;  ///< FNV-1a 64 of the parameters as report.json lists them, hex
 };
 
 /// scan.json's text.

@@ -28,9 +28,12 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 const char* status_of(ExitCode code) {
   switch (code) {
-    case ExitCode::kInput: return "invalid_input";
-    case ExitCode::kNoGroove: return "no_groove";
-    default: return "error";
+    case ExitCode::kInput:
+      return "invalid_input";
+    case ExitCode::kNoGroove:
+      return "no_groove";
+    default:
+      return "error";
   }
 }
 
@@ -39,11 +42,11 @@ void fill_counts(ScanRow& row, const Cloud& cloud, const RunResult& result) {
   row.points = cloud.size();
   row.valid_points = cloud.count_valid();
   for (std::uint8_t g : result.groove) row.groove_points += g;
-  row.seams = result.method == Method::paper
-                  ? static_cast<int>(result.paper.detection.components)
-                  : static_cast<int>(std::count_if(
-                        result.robust.seams.begin(), result.robust.seams.end(),
-                        [](const SeamCandidate& s) { return s.accepted; }));
+  row.seams =
+      result.method == Method::paper
+          ? static_cast<int>(result.paper.detection.components)
+          : static_cast<int>(std::count_if(result.robust.seams.begin(), result.robust.seams.end(),
+                                           [](const SeamCandidate& s) { return s.accepted; }));
   row.exported = static_cast<int>(result.trajectories.size());
   row.waypoints = result.trajectories.front().waypoints.size();
   row.length_m = result.trajectories.front().length;
@@ -76,10 +79,11 @@ std::vector<std::pair<std::string, std::string>> run_files(const ScanJob& job, c
   const double load_ms = ms_since(t0);
   RunResult result = run_pipeline(cloud, p, backend);
   result.timings_ms.insert(result.timings_ms.begin(), {"load", load_ms});
-  if (!backend.warning().empty()) result.warnings.insert(result.warnings.begin(), backend.warning());
+  if (!backend.warning().empty())
+    result.warnings.insert(result.warnings.begin(), backend.warning());
   auto files = render_outputs(cloud, result, p, job.path, ms_since(t0));
-  files.emplace_back("thumbnail.png", run_overview_png(cloud, result, p, job.path,
-                                                       picture::kThumbnailSide));
+  files.emplace_back("thumbnail.png",
+                     run_overview_png(cloud, result, p, job.path, picture::kThumbnailSide));
   fill_counts(row, cloud, result);
   return files;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
+
 #include "core/stats.hpp"
 
 namespace groovetrace {

@@ -9,6 +9,7 @@
 #include <groovetrace/trajectory.hpp>
 #include <limits>
 #include <string>
+
 #include "core/stats.hpp"
 
 namespace groovetrace {

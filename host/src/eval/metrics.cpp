@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
 #include "core/stats.hpp"
 
 namespace groovetrace {

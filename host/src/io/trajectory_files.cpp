@@ -1,8 +1,7 @@
-#include <groovetrace/config.hpp>
-#include <groovetrace/version.hpp>
-#include <groovetrace/trajectory_io.hpp>
-
 #include <cstdio>
+#include <groovetrace/config.hpp>
+#include <groovetrace/trajectory_io.hpp>
+#include <groovetrace/version.hpp>
 #include <nlohmann/json.hpp>
 
 namespace groovetrace {

@@ -1,11 +1,10 @@
-#include <groovetrace/config.hpp>
-#include <groovetrace/error.hpp>
-
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <groovetrace/config.hpp>
+#include <groovetrace/error.hpp>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -85,11 +84,17 @@ struct Field {
   const T& of(const Params& p) const { return p.*group.*member; }
 };
 template <class T>
-Field<PaperParams, T> paper(T PaperParams::*member) { return {&Params::paper, member}; }
+Field<PaperParams, T> paper(T PaperParams::*member) {
+  return {&Params::paper, member};
+}
 template <class T>
-Field<RobustParams, T> robust(T RobustParams::*member) { return {&Params::robust, member}; }
+Field<RobustParams, T> robust(T RobustParams::*member) {
+  return {&Params::robust, member};
+}
 template <class T>
-Field<ProgramParams, T> program(T ProgramParams::*member) { return {&Params::program, member}; }
+Field<ProgramParams, T> program(T ProgramParams::*member) {
+  return {&Params::program, member};
+}
 
 // A length parameter in metres with a plausible range, so that "--radius 3" (meant as mm)
 // is refused instead of running for an hour.
@@ -103,11 +108,10 @@ ParamSpec length(ParamScope scope, const std::string& key, const std::string& he
 template <class F>
 ParamSpec real(ParamScope scope, const std::string& key, const std::string& help, F field,
                double lo, double hi, const std::string& unit) {
-  return {key, help + " (" + unit + ")", scope,
-          [=](Params& p, const std::string& t) {
-            field.of(p) = in_range(key, t, lo, hi, " " + unit);
-          },
-          [=](const Params& p) { return num(field.of(p)); }};
+  return {
+      key, help + " (" + unit + ")", scope,
+      [=](Params& p, const std::string& t) { field.of(p) = in_range(key, t, lo, hi, " " + unit); },
+      [=](const Params& p) { return num(field.of(p)); }};
 }
 template <class F>
 ParamSpec integer(ParamScope scope, const std::string& key, const std::string& help, F field,
@@ -123,12 +127,13 @@ ParamSpec choice(const std::string& key, const std::string& help, std::string Pa
           [=](const Params& p) { return quoted(p.*field); }};
 }
 ParamSpec path(const std::string& key, const std::string& help, std::string Params::*field) {
-  return {key, help, ParamScope::common,
-          [=](Params& p, const std::string& t) {
-            if (trim(t).empty()) throw UsageError(key + ": expected a file path");
-            p.*field = t;
-          },
-          [=](const Params& p) { return (p.*field).empty() ? std::string("null") : quoted(p.*field); }};
+  return {
+      key, help, ParamScope::common,
+      [=](Params& p, const std::string& t) {
+        if (trim(t).empty()) throw UsageError(key + ": expected a file path");
+        p.*field = t;
+      },
+      [=](const Params& p) { return (p.*field).empty() ? std::string("null") : quoted(p.*field); }};
 }
 
 Eigen::Vector3f parse_viewpoint(const std::string& t) {
@@ -144,8 +149,8 @@ Eigen::Vector3f parse_viewpoint(const std::string& t) {
 
 std::string viewpoint_json(const Params& p) {
   if (!p.viewpoint) return "null";
-  return "[" + num(p.viewpoint->x()) + "," + num(p.viewpoint->y()) + "," +
-         num(p.viewpoint->z()) + "]";
+  return "[" + num(p.viewpoint->x()) + "," + num(p.viewpoint->y()) + "," + num(p.viewpoint->z()) +
+         "]";
 }
 
 // The common parameters: method, backend, input units and viewpoint.
@@ -155,13 +160,14 @@ void add_common_specs(std::vector<ParamSpec>& s) {
                kCommon,
                [](Params& p, const std::string& t) {
                  p.method = one_of("method", t, {"paper", "robust"}) == "paper" ? Method::paper
-                                                                                 : Method::robust;
+                                                                                : Method::robust;
                },
                [](const Params& p) { return quoted(to_string(p.method)); }});
   s.push_back(choice("backend", "feature backend: auto, cpu or opencl", &Params::backend,
                      {"auto", "cpu", "opencl"}));
-  s.push_back({"device", "OpenCL device: its index N or part of its name; default: first GPU, "
-                         "else first device",
+  s.push_back({"device",
+               "OpenCL device: its index N or part of its name; default: first GPU, "
+               "else first device",
                kCommon, [](Params& p, const std::string& t) { p.device = trim(t); },
                [](const Params& p) { return quoted(p.device); }});
   s.push_back({"units", "unit of the input coordinates: m or mm", kCommon,
@@ -220,10 +226,10 @@ void add_waypoint_specs(std::vector<ParamSpec>& s) {
                [](const Params& p) { return std::to_string(p.paper.slices); }});
   s.push_back(length(kRobust, "step", "robust: waypoint spacing along the seam",
                      robust(&RobustParams::step), 1e-4, 0.1));
-  s.push_back(integer(
-      kRobust, "max_seams",
-      "robust: seams exported, best first (trajectory.csv, then trajectory_1.csv...)",
-      robust(&RobustParams::max_seams), 1, 100));
+  s.push_back(
+      integer(kRobust, "max_seams",
+              "robust: seams exported, best first (trajectory.csv, then trajectory_1.csv...)",
+              robust(&RobustParams::max_seams), 1, 100));
   s.push_back(integer(kPaper, "median_max_iterations", "geometric-median iteration cap",
                       paper(&PaperParams::median_max_iterations), 1, 1000000));
   s.push_back(length(kPaper, "median_tolerance", "geometric-median stop step",
@@ -254,16 +260,17 @@ std::vector<ParamSpec> build_specs() {
   std::vector<ParamSpec> s;
   add_common_specs(s);
   add_paper_specs(s);
-  s.push_back({"viewpoint", "sensor origin X,Y,Z in the cloud's frame (m); default: PCD "
-                            "VIEWPOINT, else the origin",
+  s.push_back({"viewpoint",
+               "sensor origin X,Y,Z in the cloud's frame (m); default: PCD "
+               "VIEWPOINT, else the origin",
                ParamScope::common,
                [](Params& p, const std::string& t) { p.viewpoint = parse_viewpoint(t); },
                viewpoint_json});
   add_detection_specs(s);
   add_waypoint_specs(s);
   add_program_specs(s);
-  s.push_back(path("hand_eye", "T_flange_camera file (YAML/JSON, docs/frames.md)",
-                   &Params::hand_eye_file));
+  s.push_back(
+      path("hand_eye", "T_flange_camera file (YAML/JSON, docs/frames.md)", &Params::hand_eye_file));
   s.push_back(path("flange_pose", "T_base_flange at capture (YAML/JSON, docs/frames.md)",
                    &Params::flange_pose_file));
   return s;
@@ -365,8 +372,8 @@ std::string other_method_warning(const Params& params, const std::string& key) {
     if (spec.key != k || spec.scope == ParamScope::common) continue;
     const Method owner = spec.scope == ParamScope::paper ? Method::paper : Method::robust;
     if (owner == params.method) return {};
-    return k + " belongs to the " + to_string(owner) + " method; the " +
-           to_string(params.method) + " method ignores it";
+    return k + " belongs to the " + to_string(owner) + " method; the " + to_string(params.method) +
+           " method ignores it";
   }
   return {};
 }

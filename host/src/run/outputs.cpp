@@ -92,12 +92,14 @@ json points_report(const Cloud& input, const RunResult& result) {
     with_normal += result.normals.valid(i) ? 1 : 0;
     groove += result.groove[i];
   }
-  const std::size_t above = result.method == Method::paper
-                                ? result.paper.detection.above_threshold
-                                : result.robust.candidates;
-  return {{"total", input.size()},          {"width", input.width},
-          {"height", input.height},         {"valid", input.count_valid()},
-          {"with_normal", with_normal},     {"above_threshold", above},
+  const std::size_t above = result.method == Method::paper ? result.paper.detection.above_threshold
+                                                           : result.robust.candidates;
+  return {{"total", input.size()},
+          {"width", input.width},
+          {"height", input.height},
+          {"valid", input.count_valid()},
+          {"with_normal", with_normal},
+          {"above_threshold", above},
           {"groove", groove}};
 }
 
@@ -107,20 +109,19 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   for (const auto& [stage, ms] : result.timings_ms) timings[stage] = ms;
   timings["total"] = total_ms;
   const Trajectory& best = result.trajectories.front();
-  json report = {{"version", version()},
-                 {"input", input_path},
-                 {"method", to_string(result.method)},
-                 {"backend", result.backend},
-                 {"device", result.device},
-                 {"parameters", json::parse(params_json(params))},
-                 {"points", points_report(input, result)},
-                 {"detection", detection_report(result, params)},
-                 {"trajectory",
-                  {{"frame", best.frame},
-                   {"waypoints", best.waypoints.size()},
-                   {"length_m", best.length}}},
-                 {"timings_ms", timings},
-                 {"warnings", result.warnings}};
+  json report = {
+      {"version", version()},
+      {"input", input_path},
+      {"method", to_string(result.method)},
+      {"backend", result.backend},
+      {"device", result.device},
+      {"parameters", json::parse(params_json(params))},
+      {"points", points_report(input, result)},
+      {"detection", detection_report(result, params)},
+      {"trajectory",
+       {{"frame", best.frame}, {"waypoints", best.waypoints.size()}, {"length_m", best.length}}},
+      {"timings_ms", timings},
+      {"warnings", result.warnings}};
   if (result.method == Method::robust) {
     report["robust"] = robust_report(result.robust, params.robust.max_seams);
   }

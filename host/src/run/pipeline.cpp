@@ -92,8 +92,7 @@ void run_paper(const Cloud& cloud, const PaperParams& pp, FeatureBackend& backen
   if (d.components == 0) {
     throw NoGrooveError("no groove found: " + std::to_string(d.above_threshold) +
                         " points above threshold " + std::to_string(d.threshold) +
-                        ", no connected part of " + std::to_string(pp.min_component) +
-                        " or more");
+                        ", no connected part of " + std::to_string(pp.min_component) + " or more");
   }
   // The paper slices every point that passed the threshold: a V's two top edges and its
   // root are separate creases, often separate parts, and their median lies between them.

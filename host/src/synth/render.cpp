@@ -7,9 +7,8 @@
 #include <sstream>
 #include <string>
 
-#include "synth/internal.hpp"
-
 #include "core/stats.hpp"
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {

@@ -15,9 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "synth/internal.hpp"
-
 #include "core/stats.hpp"
+#include "synth/internal.hpp"
 
 namespace groovetrace {
 namespace {

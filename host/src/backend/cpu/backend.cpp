@@ -6,10 +6,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include "core/eigen3.hpp"
 #include <groovetrace/features.hpp>
 
 #include "backend/cpu/crease.hpp"
+#include "core/eigen3.hpp"
 #include "core/neighbor_grid.hpp"
 #include "core/stats.hpp"
 

@@ -12,7 +12,7 @@ namespace {
 
 // Kernel sources in dependency order: one program, one compile per device.
 constexpr const char* kSources[] = {"common.cl",  "eigen3.cl",     "neighbors.cl", "grid_build.cl",
-                                    "normals.cl", "descriptor.cl", "mls.cl",  "crease.cl"};
+                                    "normals.cl", "descriptor.cl", "mls.cl",       "crease.cl"};
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
