@@ -82,7 +82,21 @@ class CliBatch : public ::testing::Test {
   fs::path dir_, in_;
 };
 
+// The night in small: 20 synthetic scans (17 from the renderer, 3 rendered here) and
+// four bad ones.
 TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
+  std::map<std::string, std::string> expected;
+  const char* shapes[] = {"straight", "curve", "lshape", "box", "cylinder"};
+  fs::create_directories(in_ / "synth");
+  for (int k = 0; k < 17; ++k) {
+    const std::string name = std::string(shapes[k % 5]) + "-" + std::to_string(k);
+    const auto synth = test::run_cli("synth --shape " + std::string(shapes[k % 5]) + " --seed " +
+                                         std::to_string(k + 1) + " --resolution 640x480 -o " +
+                                         (in_ / "synth" / (name + ".pcd")).string(),
+                                     dir_);
+    ASSERT_EQ(synth.exit_code, 0) << synth.err;
+    expected["synth/" + name] = "ok";
+  }
   write_scan(in_ / "line1" / "a.pcd", 1);
   write_scan(in_ / "line1" / "b.pcd", 2);
   write_scan(in_ / "line2" / "a.pcd", 3);          // same stem, other folder: no collision
@@ -94,16 +108,17 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   const auto r = test::run_cli(batch("--jobs 2 --progress lines"), dir_,
                                "GROOVETRACE_TEST_CRASH_SCAN=crash.pcd");
   EXPECT_EQ(r.exit_code, 6) << r.err << r.out;  // docs/batch.md: some scan failed
-  const std::map<std::string, std::string> expected = {{"line1/a", "ok"},
-                                                       {"line1/b", "ok"},
-                                                       {"line2/a", "ok"},
-                                                       {"line2/flat", "no_groove"},
-                                                       {"line2/crash", "crashed"},
-                                                       {"line2/truncated", "invalid_input"},
-                                                       {"line2/empty", "invalid_input"}};
+  expected.insert({{"line1/a", "ok"},
+                   {"line1/b", "ok"},
+                   {"line2/a", "ok"},
+                   {"line2/flat", "no_groove"},
+                   {"line2/crash", "crashed"},
+                   {"line2/truncated", "invalid_input"},
+                   {"line2/empty", "invalid_input"}});
+  ASSERT_EQ(expected.size(), 24u);
   EXPECT_EQ(statuses(dir_ / "out" / "summary.csv"), expected);
   // One progress line per scan, and the scans after the crash still ran.
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 7) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 24) << r.err;
   for (const char* f : {"trajectory.csv", "program.script", "report.json", "scan.json"}) {
     EXPECT_TRUE(fs::exists(dir_ / "out" / "line2" / "a" / f)) << f;
   }
@@ -111,8 +126,8 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   EXPECT_EQ(count_files(dir_ / "out", ".tmp"), 0u);
   EXPECT_FALSE(fs::exists(dir_ / "out" / ".partial"));
   const auto summary = nlohmann::json::parse(test::read_text(dir_ / "out" / "summary.json"));
-  EXPECT_EQ(summary["scans"], 7);
-  EXPECT_EQ(summary["ok"], 3);
+  EXPECT_EQ(summary["scans"], 24);
+  EXPECT_EQ(summary["ok"], 20);
   const std::string html = test::read_text(dir_ / "out" / "index.html");
   for (const auto& [d, status] : expected) {
     EXPECT_NE(html.find("data-dir=\"" + d + "\""), std::string::npos) << d;
@@ -126,7 +141,7 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   for (const auto& [d, status] : expected) {
     EXPECT_NE(dom.find("data-dir=\"" + d + "\""), std::string::npos) << d;
   }
-  EXPECT_NE(dom.find("7 scans"), std::string::npos);
+  EXPECT_NE(dom.find("24 scans"), std::string::npos);
   EXPECT_NE(dom.find("line1/a/thumbnail.png"), std::string::npos);  // the ok scans have pictures
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;        // script errors
   // Every picture the page shows is there (a broken image is no console error).
