@@ -25,7 +25,7 @@ run() {  # program json-name [extra benchmark flags]
 
 # BENCH_ONLY="normals smooth ..." reruns some programs; BENCH_REPORT_ONLY=1 only rewrites the
 # report from the results already in $OUT.
-only=${BENCH_ONLY:-walk normals smooth descriptor crease pipeline scaling cli}
+only=${BENCH_ONLY:-walk normals smooth descriptor crease pipeline scaling cli batch}
 [ "${BENCH_REPORT_ONLY:-0}" = 1 ] && only=""
 # The organized walk's candidate counts (for the flop counts; not a timing).
 case " $only " in *" walk "*) run bench_normals walk --benchmark_filter=OrganizedWalk ;; esac
@@ -76,6 +76,8 @@ for method, backend in (("paper", "opencl"), ("paper", "cpu"), ("robust", "openc
 json.dump(result, open(f"{out}/cli.json", "w"), indent=1)
 EOF
 fi
+# The batch issue's measure: batch against one run process per scan (scripts/bench_batch.py).
+case " $only " in *" batch "*) /usr/bin/python3 scripts/bench_batch.py "$BUILD" "$OUT" ;; esac
 [ "${BENCH_REPORT_ONLY:-0}" = 1 ] || [ -n "${BENCH_ONLY:-}" ] || uptime >"$OUT/load-after.txt"
 
 /usr/bin/python3 - "$OUT" >docs/benchmarks.md <<'EOF'
@@ -85,7 +87,7 @@ out = sys.argv[1]
 runs = {}
 context = {}
 for path in sorted(glob.glob(f"{out}/*.json")):
-    if path.endswith("cli.json"):
+    if path.endswith("cli.json") or path.endswith("batch.json"):
         continue
     data = json.load(open(path))
     context = data.get("context", context)
@@ -338,5 +340,23 @@ p("|---|---:|---:|")
 for name in sorted(runs):
     if name.endswith("/640") and not name.startswith("BM_OrganizedWalk"):
         p(f"| {name[:-4]} | {fmt(ms(name), 1)} | {fmt(runs[name].get('points_per_s'), 0)} |")
+
+if os.path.exists(f"{out}/batch.json"):
+    bj = json.load(open(f"{out}/batch.json"))
+    p()
+    p("## Batch")
+    p()
+    p(f"`groovetrace batch` (default workers) against `xargs -P 2 -n 1 groovetrace run` (one "
+      f"process per scan, two at a time) on the same {bj['scans']} synthetic scans "
+      "(scripts/bench_batch.py: five shapes, default method and backend). Targets: batch at "
+      "least 1.5x the loop's frames per second, and at least 5 frames/s at 640x480.")
+    p()
+    p("| resolution | batch: frames/s | xargs -P 2: frames/s | ratio |")
+    p("|---|---:|---:|---:|")
+    for res in ("640x480", "1280x720"):
+        r = bj.get(res)
+        if r:
+            p(f"| {res} | {r['batch_fps']:.2f} | {r['xargs_fps']:.2f} | "
+              f"{r['batch_fps'] / r['xargs_fps']:.2f}x |")
 EOF
 echo "bench: wrote docs/benchmarks.md" >&2
