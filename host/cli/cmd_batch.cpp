@@ -54,10 +54,10 @@ int run_batch_command(const BatchCli& cli) {
   const BatchOptions o = options_of(cli);
   const BatchTotals t = run_batch(o);
   std::printf(
-      "groovetrace: batch: %zu scans (shard %d/%d), %zu ok, %zu failed, %zu kept from "
-      "before, %.2f frames/s; summary in %s/index.html\n",
-      t.scans, o.shard_index, o.shard_count, t.ok + (t.skipped), t.failed, t.skipped,
-      t.frames_per_second, o.out_dir.c_str());
+      "groovetrace: batch: %zu scans (shard %d/%d): %zu ok, %zu not ok, %zu of them kept "
+      "from before; %.2f frames/s; summary in %s/index.html\n",
+      t.scans, o.shard_index, o.shard_count, t.ok, t.failed, t.skipped, t.frames_per_second,
+      o.out_dir.c_str());
   return t.failed > 0 ? kSomeScansFailed : 0;
 }
 

@@ -216,6 +216,19 @@ TEST_F(CliBatch, KilledBatchResumes) {
   EXPECT_EQ(std::count(again.err.begin(), again.err.end(), '\n'), 6) << again.err;
 }
 
+// A resumed batch keeps a scan without groove and still says that not every scan is ok.
+TEST_F(CliBatch, KeptFailuresStillCount) {
+  write_scan(in_ / "line1" / "a.pcd", 1);
+  write_scan(in_ / "line1" / "flat.pcd", 2, 0.0);
+  EXPECT_EQ(test::run_cli(batch("--progress none"), dir_).exit_code, 6);
+  const auto again = test::run_cli(batch("--resume --progress lines"), dir_);
+  EXPECT_EQ(again.exit_code, 6) << again.err;
+  EXPECT_EQ(again.err, "");  // nothing run again
+  EXPECT_NE(again.out.find("2 scans (shard 0/1): 1 ok, 1 not ok, 2 of them kept"),
+            std::string::npos)
+      << again.out;
+}
+
 TEST_F(CliBatch, BadUsageAndInputs) {
   write_scan(in_ / "line1" / "a.pcd", 1);
   EXPECT_EQ(test::run_cli(batch("--shard 2/2"), dir_).exit_code, 2);

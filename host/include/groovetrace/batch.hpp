@@ -36,11 +36,11 @@ struct BatchOptions {
 
 /// Counts of a finished batch.
 struct BatchTotals {
-  std::size_t scans = 0;    ///< rows in the summary (this shard's, or all in out_dir for a report)
-  std::size_t ok = 0;       ///< status ok
-  std::size_t failed = 0;   ///< any other status
-  std::size_t skipped = 0;  ///< done before and kept (--resume)
-  double seconds = 0;       ///< wall time of this call
+  std::size_t scans = 0;         ///< this shard's scans (a report: every row in out_dir)
+  std::size_t ok = 0;            ///< of those, status ok (run now or kept)
+  std::size_t failed = 0;        ///< of those, any other status
+  std::size_t skipped = 0;       ///< done before and kept (--resume)
+  double seconds = 0;            ///< wall time of this call
   double frames_per_second = 0;  ///< scans run (not skipped) per wall second
 };
 

@@ -78,8 +78,7 @@ void make_out_dir(const std::string& out_dir) {
 
 // --resume: a scan whose directory holds a deterministic outcome for the same input and
 // parameters is kept; crashed, timeout and error rows are run again.
-bool already_done(const batch::ScanJob& job, const BatchOptions& o) {
-  batch::ScanRow row;
+bool already_done(const batch::ScanJob& job, const BatchOptions& o, batch::ScanRow& row) {
   if (!batch::read_row(o.out_dir, job.rel, row)) return false;
   if (row.status != "ok" && row.status != "no_groove" && row.status != "invalid_input") {
     return false;
@@ -122,17 +121,17 @@ BatchTotals run_batch(const BatchOptions& o) {
   make_out_dir(o.out_dir);
   batch::remove_stale_partials(o.out_dir);
   std::vector<batch::ScanJob> todo;
-  std::size_t skipped = 0;
+  std::vector<batch::ScanRow> kept, ran;
   for (const batch::ScanJob& job : mine) {
-    if (o.resume && already_done(job, o)) {
-      ++skipped;
+    batch::ScanRow row;
+    if (o.resume && already_done(job, o, row)) {
+      kept.push_back(row);
     } else {
       todo.push_back(job);
     }
   }
   Progress progress(o.progress, todo.size());
   const int workers = o.jobs > 0 ? o.jobs : default_batch_jobs();
-  std::vector<batch::ScanRow> ran;
   batch::run_in_workers(todo, o.params, o.out_dir, workers, o.scan_timeout_s,
                         [&](const batch::ScanRow& row) {
                           ran.push_back(row);
@@ -143,9 +142,11 @@ BatchTotals run_batch(const BatchOptions& o) {
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   batch::write_report(o.out_dir, batch::collect_rows(o.out_dir),
                       {seconds, ran.size(), std::min<int>(workers, std::max<int>(1, todo.size()))});
-  BatchTotals t = totals_of(ran);
-  t.scans = mine.size();
-  t.skipped = skipped;
+  // This shard's rows, kept ones included: a kept no_groove is still not ok.
+  std::vector<batch::ScanRow> rows = kept;
+  rows.insert(rows.end(), ran.begin(), ran.end());
+  BatchTotals t = totals_of(rows);
+  t.skipped = kept.size();
   t.seconds = seconds;
   t.frames_per_second = seconds > 0 ? ran.size() / seconds : 0;
   return t;
