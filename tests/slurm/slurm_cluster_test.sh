@@ -77,7 +77,7 @@ for _ in $(seq 40); do
   port_free "$base" && port_free $((base + 1)) && break
   base=$((base + 10 < 60000 ? base + 10 : 20000))
 done
-port_free "$base" && port_free $((base + 1)) || fail "two free ports near $base"
+if ! port_free "$base" || ! port_free $((base + 1)); then fail "two free ports near $base"; fi
 host=$(hostname -s)
 user=$(id -un)
 mkdir -p "$work/state" "$work/spool" "$work/jobs"
@@ -154,8 +154,9 @@ states=$(for j in "$array" "$report"; do scontrol -o show job "$j"; done 2>&1 |
 
 # Each task ran its own third of the scans, its shard taken from the array's environment.
 for k in 0 1 2; do
-  grep -q "batch: 3 scans (shard $k/3), 3 ok" "$work"/jobs/groovetrace-night-"${array}_$k".out ||
-    fail "task $k logging 'batch: 3 scans (shard $k/3), 3 ok', saw: $(tail -n 1 "$work"/jobs/groovetrace-night-"${array}_$k".out 2>&1)"
+  out="$work/jobs/groovetrace-night-${array}_$k.out"
+  grep -q "batch: 3 scans (shard $k/3), 3 ok" "$out" ||
+    fail "task $k logging 'batch: 3 scans (shard $k/3), 3 ok', saw: $(tail -n 1 "$out" 2>&1)"
 done
 
 # --- the same scans in one process.
