@@ -7,7 +7,11 @@ pkgs=(build-essential cmake pkg-config
       pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
       libgtest-dev libgmock-dev libbenchmark-dev clang-format
       libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libpng-dev
-      python3-numpy python3-matplotlib chromium)
+      python3-numpy python3-matplotlib chromium
+      munge slurm-wlm)
+# munge and slurm-wlm (slurmctld, slurmd, the client commands) are for tests/slurm, which starts
+# its own munged, slurmctld and slurmd with their own key, sockets, ports and configuration:
+# daemons the packages may start on a host with an init system neither serve nor disturb it.
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
