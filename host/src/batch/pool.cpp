@@ -52,14 +52,10 @@ std::string host_name() {
       run_scan(jobs.at(index), params, *backend, out_dir);
     } catch (const std::exception& e) {
       // The backend or OUTDIR itself failed: the scan's row says so.
-      ScanRow row;
-      row.scan = jobs.at(index).path;
-      row.dir = jobs.at(index).rel;
-      row.status = "error";
-      row.exit_code = static_cast<int>(ExitCode::kInternal);
-      row.message = e.what();
       try {
-        write_failure(row, out_dir);
+        write_failure(
+            failure_row(jobs.at(index), "error", static_cast<int>(ExitCode::kInternal), e.what()),
+            out_dir);
       } catch (const std::exception&) {
         ::_exit(static_cast<int>(ExitCode::kInput));
       }
@@ -170,8 +166,9 @@ class Pool {
   ScanRow read_back(long index) {
     ScanRow row;
     if (!read_row(out_dir_, jobs_[static_cast<std::size_t>(index)].rel, row)) {
-      row = failed_row(index, "error", static_cast<int>(ExitCode::kInternal),
-                       "the worker reported the scan done but left no scan.json");
+      row = failure_row(jobs_[static_cast<std::size_t>(index)], "error",
+                        static_cast<int>(ExitCode::kInternal),
+                        "the worker reported the scan done but left no scan.json");
     }
     return row;
   }
@@ -180,17 +177,6 @@ class Pool {
     w.job = -1;
     ++finished_;
     on_row_(row);
-  }
-
-  ScanRow failed_row(long index, const std::string& status, int code, const std::string& msg) {
-    const ScanJob& job = jobs_[static_cast<std::size_t>(index)];
-    ScanRow row;
-    row.scan = job.path;
-    row.dir = job.rel;
-    row.status = status;
-    row.exit_code = code;
-    row.message = msg;
-    return row;
   }
 
   // A worker that died: its finished scans count, the one it ran is recorded as crashed.
@@ -206,7 +192,8 @@ class Pool {
                                         strsignal(sig) + ") while running this scan"
                                   : "worker exited with code " +
                                         std::to_string(WEXITSTATUS(status)) + " during this scan";
-      record(w, failed_row(job, "crashed", sig ? 128 + sig : WEXITSTATUS(status), why));
+      record(w, failure_row(jobs_[static_cast<std::size_t>(job)], "crashed",
+                            sig ? 128 + sig : WEXITSTATUS(status), why));
     }
     if (finished_ < jobs_.size()) spawn(w);
   }
@@ -219,7 +206,8 @@ class Pool {
     stop(w);
     char msg[128];
     std::snprintf(msg, sizeof msg, "killed after %.0f s (--scan-timeout)", timeout_s_);
-    record(w, failed_row(job, "timeout", static_cast<int>(ExitCode::kInternal), msg));
+    record(w, failure_row(jobs_[static_cast<std::size_t>(job)], "timeout",
+                          static_cast<int>(ExitCode::kInternal), msg));
     if (finished_ < jobs_.size()) spawn(w);
   }
 

@@ -93,10 +93,10 @@ std::string csv_line(const ScanRow& r) {
          csv_cell(stages) + "," + r.input_hash + "," + r.params_hash + "\n";
 }
 
-std::uint64_t fnv1a64(const std::string& bytes, std::uint64_t seed) {
+std::uint64_t fnv1a64(const char* data, std::size_t size, std::uint64_t seed) {
   std::uint64_t h = seed;
-  for (unsigned char c : bytes) {
-    h ^= c;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= static_cast<unsigned char>(data[i]);
     h *= 1099511628211ull;
   }
   return h;
@@ -114,7 +114,7 @@ std::string file_hash(const std::string& path) {
   std::uint64_t h = 14695981039346656037ull;
   std::string chunk(1 << 20, '\0');
   while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
-    h = fnv1a64(chunk.substr(0, static_cast<std::size_t>(in.gcount())), h);
+    h = fnv1a64(chunk.data(), static_cast<std::size_t>(in.gcount()), h);
   }
   return hex64(h);
 }

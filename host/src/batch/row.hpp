@@ -39,8 +39,14 @@ ScanRow row_from_json(const std::string& text, const std::string& where);
 std::string csv_header();
 std::string csv_line(const ScanRow& row);
 
-/// FNV-1a 64 of `bytes`, continuing from `seed`.
-std::uint64_t fnv1a64(const std::string& bytes, std::uint64_t seed = 14695981039346656037ull);
+/// FNV-1a 64 of `size` bytes at `data`, continuing from `seed`.
+std::uint64_t fnv1a64(const char* data, std::size_t size,
+                      std::uint64_t seed = 14695981039346656037ull);
+
+/// FNV-1a 64 of `bytes`.
+inline std::uint64_t fnv1a64(const std::string& bytes) {
+  return fnv1a64(bytes.data(), bytes.size());
+}
 
 /// 16 lower-case hex digits.
 std::string hex64(std::uint64_t value);

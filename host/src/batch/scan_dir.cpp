@@ -131,6 +131,17 @@ ScanRow run_scan(const ScanJob& job, const Params& batch_params, FeatureBackend&
   return row;
 }
 
+ScanRow failure_row(const ScanJob& job, const std::string& status, int exit_code,
+                    const std::string& message) {
+  ScanRow row;
+  row.scan = job.path;
+  row.dir = job.rel;
+  row.status = status;
+  row.exit_code = exit_code;
+  row.message = message;
+  return row;
+}
+
 void write_failure(const ScanRow& row, const std::string& out_dir) {
   write_scan_dir(out_dir, row.dir, {{"scan.json", row_json(row)}});
 }

@@ -24,6 +24,10 @@ std::string params_hash(const Params& params);
 ScanRow run_scan(const ScanJob& job, const Params& batch_params, FeatureBackend& backend,
                  const std::string& out_dir);
 
+/// The row of a scan that produced nothing: `status` with its exit code and one-line message.
+ScanRow failure_row(const ScanJob& job, const std::string& status, int exit_code,
+                    const std::string& message);
+
 /// Writes a row for a scan whose worker died or ran out of time (scan.json alone).
 void write_failure(const ScanRow& row, const std::string& out_dir);
 
