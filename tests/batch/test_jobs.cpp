@@ -43,6 +43,8 @@ TEST(BatchJobs, FoldersAreSearchedSortedAndNamesNeverCollide) {
                                                   "a/x.labels", "b/scan"}));
   EXPECT_EQ(jobs[1].path, (d / "other" / "a" / "s1.pcd").string());
   EXPECT_THROW(list_jobs({(d / "missing").string()}), InputError);
+  touch(d / "loose" / "scan");  // a file named on the command line needs no extension
+  EXPECT_EQ(rels(list_jobs({(d / "loose" / "scan").string()})), std::vector<std::string>{"scan"});
   fs::create_directories(d / "nothing");
   EXPECT_THROW(list_jobs({(d / "nothing").string()}), InputError);
 }

@@ -9,18 +9,15 @@
 #include <set>
 #include <sstream>
 
+#include "io/text.hpp"
+
 namespace groovetrace::batch {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 bool is_scan(const fs::path& p) {
-  const std::string ext = lower(p.extension().string());
+  const std::string ext = io::lower_extension(p.string());
   return ext == ".pcd" || ext == ".ply";
 }
 
@@ -86,7 +83,8 @@ Eigen::Vector3f parse_viewpoint(const std::string& text, const std::string& wher
 }
 
 std::string extension_of(const ScanJob& job) {
-  return lower(fs::path(job.path).extension().string().substr(1));
+  const std::string ext = io::lower_extension(job.path);
+  return ext.empty() ? ext : ext.substr(1);
 }
 
 // Makes every job's directory unique: where scans of different types share one, each gets its
@@ -150,7 +148,7 @@ std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
     std::vector<ScanJob> found;
     if (fs::is_directory(p, ec)) {
       found = scans_in_directory(p);
-    } else if (fs::is_regular_file(p, ec) && lower(p.extension().string()) == ".csv") {
+    } else if (fs::is_regular_file(p, ec) && io::lower_extension(p.string()) == ".csv") {
       found = read_manifest(input);
     } else if (fs::exists(p, ec)) {
       found.push_back({input, p.stem().string(), "", "", std::nullopt});
