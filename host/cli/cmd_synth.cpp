@@ -21,6 +21,7 @@ struct SynthOptions {
   std::string shape, seed, width, height, resolution, distance, tilt, roll;
   std::string groove_width, groove_angle, groove_depth, root_gap, noise = "on", effects = "all";
   std::string depth_unit, output;
+  std::string joint, misalignment, tacks, tack_height, clamps, clutter, pipe_diameter;
 };
 
 double to_double(const std::string& flag, const std::string& text) {
@@ -37,6 +38,27 @@ long long to_integer(const std::string& flag, const std::string& text) {
   if (text.empty() || *end != '\0')
     throw UsageError("synth: " + flag + " expects an integer, got '" + text + "'");
   return v;
+}
+
+int to_count(const std::string& flag, const std::string& text) {
+  const long long v = to_integer(flag, text);
+  if (v < 0 || v > 1000)
+    throw UsageError("synth: " + flag + " expects a small count, got '" + text + "'");
+  return static_cast<int>(v);
+}
+
+// Issue 12's joints and conditions.
+void joint_params(const SynthOptions& o, SynthParams& p) {
+  if (!o.joint.empty()) p.joint = parse_joint(o.joint);
+  // A single bevel's usual angle; the V's default (60 deg) would make it 17 mm deep.
+  if (p.joint == JointType::kBevel && o.groove_angle.empty() && o.groove_depth.empty())
+    p.groove_angle_deg = 45.0;
+  if (!o.misalignment.empty()) p.misalignment = to_double("--misalignment", o.misalignment);
+  if (!o.tacks.empty()) p.tacks = to_count("--tacks", o.tacks);
+  if (!o.tack_height.empty()) p.tack_height_fraction = to_double("--tack-height", o.tack_height);
+  if (!o.clamps.empty()) p.clamps = to_count("--clamps", o.clamps);
+  if (!o.clutter.empty()) p.clutter = to_count("--clutter", o.clutter);
+  if (!o.pipe_diameter.empty()) p.pipe_diameter = to_double("--pipe-diameter", o.pipe_diameter);
 }
 
 SynthParams to_params(const SynthOptions& o) {
@@ -83,6 +105,7 @@ SynthParams to_params(const SynthOptions& o) {
     throw UsageError("synth: --noise expects on or off, got '" + o.noise + "'");
   p.effects = parse_effects(o.effects);
   if (!o.depth_unit.empty()) p.depth_unit = to_double("--depth-unit", o.depth_unit);
+  joint_params(o, p);
   validate(p);
   return p;
 }
@@ -105,7 +128,8 @@ Command add_synth_command(CLI::App& app) {
   sub->add_option("--tilt", o->tilt, "Camera pitch across the seam, deg (default 0)");
   sub->add_option("--roll", o->roll, "Camera roll about its optical axis, deg (default 0)");
   sub->add_option("--groove-width", o->groove_width, "Groove top width, m (default 0.010)");
-  sub->add_option("--groove-angle", o->groove_angle, "Included angle of the V, deg (default 60)");
+  sub->add_option("--groove-angle", o->groove_angle,
+                  "Included angle between the walls, deg (default 60; bevel 45)");
   sub->add_option("--groove-depth", o->groove_depth, "Depth of the V, m (instead of the angle)");
   sub->add_option("--root-gap", o->root_gap, "Root gap, m (default 0.0005)");
   sub->add_option("--noise", o->noise, "Sensor model on|off (default on)");
@@ -114,6 +138,17 @@ Command add_synth_command(CLI::App& app) {
                   "depth,undulation,blur,flying,grazing,shadow,band,dropout,minz,quantize");
   sub->add_option("--depth-unit", o->depth_unit,
                   "Depth quantisation, m: 0.001 (default) or 0.0001");
+  sub->add_option("--joint", o->joint, "Joint: v (default), bevel, fillet (T-joint), lap");
+  sub->add_option("--misalignment", o->misalignment,
+                  "High-low: the +y part's top this much higher, m (default 0; 0-0.005)");
+  sub->add_option("--tacks", o->tacks, "Tack welds per seam, in view (default 0; 0-10)");
+  sub->add_option("--tack-height", o->tack_height,
+                  "Tack height as a fraction of the joint depth (default 0.7; 0.1-1)");
+  sub->add_option("--clamps", o->clamps, "Clamps on the plates beside the seam (default 0; 0-4)");
+  sub->add_option("--clutter", o->clutter,
+                  "Loose 20x20x150 mm bars on the table beside the part (default 0; 0-2)");
+  sub->add_option("--pipe-diameter", o->pipe_diameter,
+                  "Outer diameter of cylinder and pipe-long, m (default 0.10; 0.06-0.20)");
   sub->add_option("-o,--output", o->output, "Output scan SCAN.pcd (truth files beside it)")
       ->required();
 

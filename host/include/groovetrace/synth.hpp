@@ -31,6 +31,19 @@ enum class Shape {
   kMulti,     ///< two parallel straight grooves, 80 mm apart, in the plate
 };
 
+/// The joint whose seam the workpiece carries (issue 12). docs/synthetic-scans.md, "Joints".
+enum class JointType {
+  kV,       ///< butt joint, symmetric V groove (the paper's)
+  kBevel,   ///< butt joint, single bevel: vertical wall on the -y side, inclined wall on +y
+  kFillet,  ///< T-joint: a web standing on the plate along the seam; the seam is the corner
+  kLap,     ///< lap joint: a second plate lying on the +y side; the seam is its edge's corner
+};
+
+/// Truth-file and CLI name of a joint: "V", "bevel", "fillet", "lap" (the CLI also takes "v").
+GT_API const char* joint_name(JointType joint);
+/// Inverse of joint_name (also "v"); throws UsageError listing the known names.
+GT_API JointType parse_joint(const std::string& name);
+
 /// Lower-case CLI name of a shape ("straight", "curve", "box", "cylinder", "pipe-long",
 /// "lshape", "multi").
 GT_API const char* shape_name(Shape shape);
@@ -102,6 +115,16 @@ struct SynthParams {
   SensorEffects effects;           ///< which effects apply when noise is on
   double depth_unit = 0.001;       ///< depth quantisation step (m): 0.001 default, 0.0001 fine
   SensorModel sensor;
+
+  // Real-shop joints and conditions (issue 12). At their defaults the scan is the V groove
+  // of the paper's scenes, byte for byte.
+  JointType joint = JointType::kV;    ///< the joint (fillet and lap: plate shapes only)
+  double misalignment = 0.0;          ///< high-low (m, 0-0.005): the +y part's top is this higher
+  int tacks = 0;                      ///< tack welds per seam (0-10), in the in-view part
+  double tack_height_fraction = 0.7;  ///< tack height as a fraction of the joint depth (0.1-1)
+  int clamps = 0;                     ///< clamp blocks on the plates beside the seam (0-4)
+  int clutter = 0;                    ///< loose bars lying on the table beside the part (0-2)
+  double pipe_diameter = 0.10;        ///< outer diameter of cylinder and pipe-long (m, 0.06-0.20)
 };
 
 /// Checks parameter ranges; throws UsageError naming the offending parameter.
@@ -110,15 +133,23 @@ GT_API void validate(const SynthParams& params);
 /// The groove's cross-section as built (metres, degrees). The V's walls run from the two top
 /// edges (top_width apart) down to the root at `depth`; below the root a vertical gap of
 /// width root_gap runs through the rest of the part (`thickness`).
+///
+/// Other joints (docs/synthetic-scans.md, "Joints"): bevel - top_width from the vertical wall
+/// to the inclined wall's top edge, included_angle between the two walls; fillet and lap -
+/// top_width is the weld face (the hypotenuse of the isosceles right triangle in the corner),
+/// depth its throat (top_width / 2), included_angle 90, root_gap 0.
 struct GrooveGeometry {
   double top_width = 0.0;
   double depth = 0.0;
   double included_angle_deg = 0.0;
   double root_gap = 0.0;
-  double thickness = 0.0;  ///< plate, block top or pipe wall thickness (m)
+  double thickness = 0.0;     ///< plate, block top or pipe wall thickness (m)
+  double misalignment = 0.0;  ///< high-low (m): the +y part's top above the -y part's
 };
-/// The geometry SynthParams describe: depth = (top_width - root_gap) / (2 tan(angle / 2))
-/// unless groove_depth is given; thickness = max(10 mm, depth + 1.5 mm).
+/// The geometry SynthParams describe: V: depth = (top_width - root_gap) / (2 tan(angle / 2)),
+/// bevel: depth = (top_width - root_gap) / tan(angle), unless groove_depth is given;
+/// thickness = max(10 mm, depth + 1.5 mm). Fillet and lap: depth = top_width / 2, leg =
+/// top_width / sqrt(2), thickness = max(10 mm, leg + 1.5 mm).
 GT_API GrooveGeometry groove_geometry(const SynthParams& params);
 
 /// Pinhole camera (no distortion, as RealSense depth streams). Pixel (u, v) = (column, row)
@@ -134,19 +165,30 @@ struct CameraModel {
 /// cx = (width - 1) / 2, cy = (height - 1) / 2. 1280x720: fx 1004.6, fy 989.1.
 GT_API CameraModel d415_camera(int width, int height, const SensorModel& sensor = {});
 
+/// A tack weld in a seam: a rounded hump filling the joint up to a fraction of its depth.
+struct Tack {
+  double position = 0.0;                             ///< arc length along the seam's root (m)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< on the root line (m)
+  double length = 0.0;                               ///< along the seam (m)
+  double height = 0.0;  ///< top above the root, along the seam's normal (m)
+};
+
 /// One seam's true root line. Vertices are about 1 mm apart; a closed seam repeats its first
 /// vertex at the end. All vectors in the frame of the container (camera frame in SynthTruth).
 struct Seam {
   std::vector<Eigen::Vector3d> root;      ///< root line (m): centre of the gap at the V's bottom
   std::vector<Eigen::Vector3d> normal;    ///< unit surface normal of the part there, out of the
-                                          ///< workpiece (towards the camera side)
+                                          ///< workpiece (towards the camera side); fillet and
+                                          ///< lap: the bisector (the root is a corner)
   std::vector<Eigen::Vector3d> bisector;  ///< unit bisector of the two walls, out of the
                                           ///< groove; the tool z axis should be -bisector
   std::vector<std::uint8_t> in_view;      ///< 1: inside the image where the sensor can return,
                                           ///< facing the camera, the groove above it unhidden
   bool closed = false;
-  double length() const;          ///< polyline length (m)
-  double length_in_view() const;  ///< length of the segments with both ends in view (m)
+  JointType joint = JointType::kV;  ///< the joint along this seam
+  std::vector<Tack> tacks;          ///< tack welds on it (centres in the container's frame)
+  double length() const;            ///< polyline length (m)
+  double length_in_view() const;    ///< length of the segments with both ends in view (m)
 };
 
 /// Ground truth of a scan, aligned with its cloud.
@@ -156,7 +198,8 @@ struct SynthTruth {
   CameraModel camera;
   Eigen::Isometry3d T_workpiece_camera = Eigen::Isometry3d::Identity();
   std::vector<std::uint8_t> label;  ///< per point, cloud order: 1 = on a groove wall (between
-                                    ///< the two top edges, root gap included), else 0
+                                    ///< the two top edges, root gap included), in a fillet or
+                                    ///< lap corner's region, or on a tack; else 0
   std::vector<std::uint8_t> valid;  ///< per point: 1 = the scan has a return (finite point)
   std::vector<Seam> seams;          ///< camera frame
 };

@@ -19,7 +19,8 @@ struct RayHit {
   double t = 0.0;          ///< distance along the unit ray direction (m)
   Eigen::Vector3d point;   ///< m
   Eigen::Vector3d normal;  ///< unit, out of the solid
-  std::uint8_t label = 0;  ///< 1 = groove wall (or the table seen through the root gap)
+  std::uint8_t label = 0;  ///< 1 = groove wall (or the table seen through the root gap), a
+                           ///< fillet or lap corner's region, or a tack
   bool table = false;      ///< the hit is on the table plane
 };
 
@@ -41,8 +42,14 @@ class SynthScene {
   /// Signed distance bound of the workpiece (m): <= 0 inside, > 0 outside, 1-Lipschitz (not
   /// the table).
   double signed_distance(const Eigen::Vector3d& p) const;
-  /// The seams' root lines in the workpiece frame (in_view all 1).
+  /// The seams' root lines in the workpiece frame (in_view all 1), with their joint and tacks.
   std::vector<Seam> seams() const;
+  /// Adds what depends on the view (extras.cpp): tack welds along the part of each seam the
+  /// camera sees, clamps near that part's ends, loose bars beside the part. Positions come
+  /// from params.seed (a stream of its own: the sensor's noise does not change). Call once,
+  /// before rendering.
+  void place_extras(const SynthParams& params, const CameraModel& camera,
+                    const Eigen::Isometry3d& T_workpiece_camera);
   /// The point the camera looks at: the seam's centre on the top surface (m).
   Eigen::Vector3d look_at() const;
   const GrooveGeometry& groove() const;
@@ -54,7 +61,9 @@ class SynthScene {
 
 /// Camera pose for the params: looking straight down at scene.look_at() from `distance`
 /// with image x along the seam (+x of the workpiece), then pitched by tilt about the camera
-/// x axis and rolled about its optical axis, both about the look-at point.
+/// x axis and rolled about its optical axis, both about the look-at point. Fillet and lap
+/// joints start pitched by 45 deg (the camera on the -y side, looking down the corner's
+/// bisector); tilt adds to that.
 Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene);
 
 /// What an ideal sensor sees, per pixel in row-major order.

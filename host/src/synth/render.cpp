@@ -29,6 +29,60 @@ void require(bool ok, const std::string& what, double value, const std::string& 
 
 }  // namespace
 
+namespace {
+
+void require_shape(bool ok, const std::string& what, const SynthParams& p,
+                   const std::string& allowed) {
+  if (ok) return;
+  throw UsageError("synth: " + what + " is not available for shape " + shape_name(p.shape) + " (" +
+                   allowed + ")");
+}
+
+// The joint's cross-section and the conditions (issue 12).
+void validate_joint(const SynthParams& p) {
+  const bool corner = p.joint == JointType::kFillet || p.joint == JointType::kLap;
+  const bool pipe = p.shape == Shape::kCylinder || p.shape == Shape::kPipeLong;
+  require(std::isfinite(p.groove_width) && p.groove_width >= 0.002 &&
+              p.groove_width <= (corner ? 0.04 : 0.10),
+          "groove width", p.groove_width,
+          corner ? "0.002-0.04 m for fillet and lap" : "0.002-0.10 m");
+  if (p.groove_depth > 0.0) {
+    require(std::isfinite(p.groove_depth) && p.groove_depth >= 0.001 && p.groove_depth <= 0.03,
+            "groove depth", p.groove_depth, "0.001-0.03 m");
+  } else if (p.joint == JointType::kBevel) {
+    require(std::isfinite(p.groove_angle_deg) && p.groove_angle_deg >= 10.0 &&
+                p.groove_angle_deg <= 80.0,
+            "groove angle", p.groove_angle_deg, "10-80 deg for a bevel");
+  } else {
+    require(std::isfinite(p.groove_angle_deg) && p.groove_angle_deg >= 20.0 &&
+                p.groove_angle_deg <= 170.0,
+            "groove angle", p.groove_angle_deg, "20-170 deg");
+  }
+  require_shape(!corner || (!pipe && !(p.joint == JointType::kLap && p.shape == Shape::kMulti)),
+                std::string("joint ") + joint_name(p.joint), p,
+                p.joint == JointType::kFillet ? "fillet: straight, curve, lshape, multi, box"
+                                              : "lap: straight, curve, lshape, box");
+  require(std::isfinite(p.misalignment) && p.misalignment >= 0.0 && p.misalignment <= 0.005,
+          "misalignment", p.misalignment, "0-0.005 m");
+  if (p.misalignment > 0.0) {
+    require_shape(p.shape != Shape::kMulti, "misalignment", p, "one seam: every shape but multi");
+    if (corner)
+      throw UsageError("synth: misalignment is for butt joints (V, bevel), not " +
+                       std::string(joint_name(p.joint)));
+  }
+  require(p.tacks >= 0 && p.tacks <= 10, "tacks", p.tacks, "0-10");
+  require(std::isfinite(p.tack_height_fraction) && p.tack_height_fraction >= 0.1 &&
+              p.tack_height_fraction <= 1.0,
+          "tack height fraction", p.tack_height_fraction, "0.1-1");
+  require(p.clamps >= 0 && p.clamps <= 4, "clamps", p.clamps, "0-4");
+  if (p.clamps > 0) require_shape(!pipe, "clamps", p, "plates and box");
+  require(p.clutter >= 0 && p.clutter <= 2, "clutter", p.clutter, "0-2");
+  require(std::isfinite(p.pipe_diameter) && p.pipe_diameter >= 0.06 && p.pipe_diameter <= 0.20,
+          "pipe diameter", p.pipe_diameter, "0.06-0.20 m");
+}
+
+}  // namespace
+
 void validate(const SynthParams& p) {
   require(std::isfinite(p.distance) && p.distance >= 0.2 && p.distance <= 1.5, "distance",
           p.distance, "0.2-1.5 m; D415 scans: 0.3-0.6 m");
@@ -38,23 +92,17 @@ void validate(const SynthParams& p) {
           "-180..180 deg");
   require(p.width >= 32 && p.width <= 4096, "width", p.width, "32-4096 px");
   require(p.height >= 32 && p.height <= 4096, "height", p.height, "32-4096 px");
-  require(std::isfinite(p.groove_width) && p.groove_width >= 0.002 && p.groove_width <= 0.04,
-          "groove width", p.groove_width, "0.002-0.04 m");
+  validate_joint(p);
   require(std::isfinite(p.root_gap) && p.root_gap >= 0.0 && p.root_gap <= 0.003 &&
               p.root_gap < p.groove_width,
           "root gap", p.root_gap, "0-0.003 m and below the groove width");
-  if (p.groove_depth > 0.0) {
-    require(std::isfinite(p.groove_depth) && p.groove_depth >= 0.001 && p.groove_depth <= 0.03,
-            "groove depth", p.groove_depth, "0.001-0.03 m");
-  } else {
-    require(std::isfinite(p.groove_angle_deg) && p.groove_angle_deg >= 20.0 &&
-                p.groove_angle_deg <= 150.0,
-            "groove angle", p.groove_angle_deg, "20-150 deg");
-  }
   require(std::isfinite(p.depth_unit) && p.depth_unit >= 1e-5 && p.depth_unit <= 0.01, "depth unit",
           p.depth_unit, "1e-5-0.01 m; D415: 0.001 or 0.0001");
   const GrooveGeometry g = groove_geometry(p);
   require(g.depth <= 0.03, "groove depth", g.depth, "at most 0.03 m; widen the angle");
+  if (p.shape == Shape::kCylinder || p.shape == Shape::kPipeLong)
+    require(g.thickness <= 0.6 * 0.5 * p.pipe_diameter, "groove depth", g.depth,
+            "the pipe wall (depth + 1.5 mm) at most 0.6 of the pipe's radius");
 }
 
 double Seam::length() const {
@@ -74,8 +122,11 @@ Eigen::Isometry3d camera_pose(const SynthParams& params, const SynthScene& scene
   // Straight down with image x along the seam: camera x = +x, y = -y, z = -z (workpiece).
   Eigen::Matrix3d down;
   down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  // Fillet and lap joints are seen down their corner's bisector, from the -y side.
+  const bool corner = params.joint == JointType::kFillet || params.joint == JointType::kLap;
+  const double pitch_deg = corner ? params.tilt_deg + 45.0 : params.tilt_deg;
   const Eigen::Matrix3d R_workpiece_camera =
-      down * Eigen::AngleAxisd(params.tilt_deg * kDeg, Eigen::Vector3d::UnitX()) *
+      down * Eigen::AngleAxisd(pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
       Eigen::AngleAxisd(params.roll_deg * kDeg, Eigen::Vector3d::UnitZ());
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = R_workpiece_camera;
@@ -118,9 +169,11 @@ IdealFrame render_ideal(const SynthScene& scene, const CameraModel& camera,
 
 SynthScan render(const SynthParams& params) {
   validate(params);
-  const SynthScene scene(params);
+  SynthScene scene(params);
   const CameraModel camera = d415_camera(params.width, params.height, params.sensor);
   const Eigen::Isometry3d T_workpiece_camera = camera_pose(params, scene);
+  if (params.tacks > 0 || params.clamps > 0 || params.clutter > 0)
+    scene.place_extras(params, camera, T_workpiece_camera);
   const IdealFrame ideal = render_ideal(scene, camera, T_workpiece_camera, params);
 
   SynthScan scan;
@@ -168,6 +221,7 @@ SynthScan render(const SynthParams& params) {
       seam.normal[k] = T_camera_workpiece.linear() * seam.normal[k];
       seam.bisector[k] = T_camera_workpiece.linear() * seam.bisector[k];
     }
+    for (Tack& tack : seam.tacks) tack.centre = T_camera_workpiece * tack.centre;
     truth.seams.push_back(std::move(seam));
   }
   return scan;

@@ -1,12 +1,7 @@
-// Workpieces of the synthetic scans as signed distance bounds, and ray casting against them.
-//
-// Every workpiece is a body (a box or a pipe) minus the groove's cut. The cut is defined in a
-// 2-D cross-section (d, z'): d = distance from the seam's centre plane or path (>= 0), z' =
-// height relative to the top surface. Because (d, z') is a 1-Lipschitz function of the 3-D
-// point, a 1-Lipschitz 2-D bound composed with it is a valid 3-D distance bound, so one cut
-// function serves straight, curved, circumferential and axial seams alike. Sphere tracing on
-// that bound, then bisection on its sign, finds the exact boundary of the solid, whose faces
-// (planes, cylinders) are therefore hit to far better than 1e-5 m.
+// Workpieces of the synthetic scans as signed distance bounds, and ray casting against them
+// (the bound's parts: synth/scene_impl.hpp). Sphere tracing on that bound, then bisection on
+// its sign, finds the exact boundary of the solid, whose faces (planes, cylinders) are
+// therefore hit to far better than 1e-5 m.
 
 #include <algorithm>
 #include <cmath>
@@ -17,260 +12,17 @@
 
 #include "core/stats.hpp"
 #include "synth/internal.hpp"
+#include "synth/scene_impl.hpp"
 
 namespace groovetrace {
-namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Ray marching: steps never shorter than this (m), so grazing rays make progress; a sign
-// change within a step is then bisected down to kBisectTolerance.
-constexpr double kMinStep = 1e-5;
-constexpr double kBisectTolerance = 1e-8;
-constexpr int kMaxSteps = 4096;
-// Seam vertices are this far apart (m).
-constexpr double kSeamStep = 0.001;
-
-// One piece of a seam's path in the table plane (workpiece x, y): a segment or an arc.
-struct PathPiece {
-  bool arc = false;
-  Eigen::Vector2d a{0, 0}, b{0, 0};  // end points (for arcs too)
-  Eigen::Vector2d centre{0, 0};      // arc only
-  double radius = 0.0;
-  double start = 0.0;        // angle of `a` around the centre (rad)
-  double sweep = 0.0;        // signed: > 0 counter-clockwise (rad)
-  double inv_length2 = 0.0;  // segment only: 1 / |b - a|^2
-
-  static PathPiece segment(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-    PathPiece p;
-    p.a = from;
-    p.b = to;
-    p.inv_length2 = 1.0 / (to - from).squaredNorm();
-    return p;
-  }
-  static PathPiece make_arc(const Eigen::Vector2d& centre, double radius, double start,
-                            double sweep) {
-    PathPiece p;
-    p.arc = true;
-    p.centre = centre;
-    p.radius = radius;
-    p.start = start;
-    p.sweep = sweep;
-    p.a = centre + radius * Eigen::Vector2d(std::cos(start), std::sin(start));
-    p.b = centre + radius * Eigen::Vector2d(std::cos(start + sweep), std::sin(start + sweep));
-    return p;
-  }
-
-  double length() const { return arc ? radius * std::abs(sweep) : (b - a).norm(); }
-
-  Eigen::Vector2d at(double s) const {
-    if (!arc) return a + (b - a) * (s / length());
-    const double angle = start + std::copysign(s / radius, sweep);
-    return centre + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-  }
-
-  double distance(const Eigen::Vector2d& p) const {
-    if (!arc) {
-      const Eigen::Vector2d ab = b - a;
-      const double s = std::clamp((p - a).dot(ab) * inv_length2, 0.0, 1.0);
-      return (p - (a + s * ab)).norm();
-    }
-    const Eigen::Vector2d q = p - centre;
-    bool within = false;
-    if (std::abs(sweep) <= kPi) {
-      // Inside the arc's wedge: on the sweep side of the start ray and before the end ray
-      // (cross products; cheaper than atan2, which this runs millions of times).
-      const Eigen::Vector2d s = a - centre, e = b - centre;
-      const double sense = sweep > 0 ? 1.0 : -1.0;
-      within = sense * (s.x() * q.y() - s.y() * q.x()) >= 0.0 &&
-               sense * (q.x() * e.y() - q.y() * e.x()) >= 0.0;
-    } else {
-      // Angle of p from `start` in the arc's sense of rotation, in [0, 2 pi).
-      double rel = std::atan2(q.y(), q.x()) - start;
-      if (sweep < 0) rel = -rel;
-      rel -= 2.0 * kPi * std::floor(rel / (2.0 * kPi));
-      within = rel <= std::abs(sweep);
-    }
-    if (within) return std::abs(q.norm() - radius);
-    return std::min((p - a).norm(), (p - b).norm());
-  }
-};
-
-using Path = std::vector<PathPiece>;
-
-enum class Body { kBox, kPipe };
-// How the cross-section coordinates (d, z') are taken from a 3-D point.
-enum class Profile {
-  kPath,             // d = distance to a path in the table plane, z' = z - top
-  kCircumferential,  // d = |x| (groove plane x = 0), z' = radius from the pipe axis - R
-  kAxial,            // d = |y| (groove plane y = 0), z' = z - top of the pipe
-};
-
-}  // namespace
-
-struct SynthScene::Impl {
-  GrooveGeometry groove;
-  double half_gap = 0.0;
-  double k = 0.0;          // tan(included angle / 2): wall run per unit of depth
-  double wall_norm = 1.0;  // 1 / sqrt(1 + k^2), makes the wall's distance 1-Lipschitz
-
-  Body body = Body::kBox;
-  Eigen::Vector3d box_min{0, 0, 0}, box_max{0, 0, 0};  // also the bounding box of a pipe
-  double pipe_radius = 0.0, pipe_inner = 0.0, pipe_half_length = 0.0, pipe_axis_z = 0.0;
-
-  Profile profile = Profile::kPath;
-  std::vector<Path> paths;
-  double top_z = 0.0;         // height of the top surface at the seam (m)
-  bool gap_to_table = false;  // the root gap runs down to the table (plates)
-
-  Eigen::Vector3d look_at{0, 0, 0};
-
-  double path_distance(const Eigen::Vector2d& p) const {
-    double d = kInf;
-    for (const Path& path : paths)
-      for (const PathPiece& piece : path) d = std::min(d, piece.distance(p));
-    return d;
-  }
-
-  double pipe_rho(const Eigen::Vector3d& p) const {
-    const double dz = p.z() - pipe_axis_z;
-    return std::sqrt(p.y() * p.y() + dz * dz);
-  }
-
-  // Cross-section coordinates of p.
-  void section(const Eigen::Vector3d& p, double& d, double& zr) const {
-    switch (profile) {
-      case Profile::kPath:
-        d = path_distance(p.head<2>());
-        zr = p.z() - top_z;
-        break;
-      case Profile::kCircumferential:
-        d = std::abs(p.x());
-        zr = pipe_rho(p) - pipe_radius;
-        break;
-      case Profile::kAxial:
-        d = std::abs(p.y());
-        zr = p.z() - (pipe_axis_z + pipe_radius);
-        break;
-    }
-  }
-
-  // Distance bound of the cut (< 0 inside): the slot |d| < gap/2 united with the V whose
-  // walls reach the top width at z' = 0, both limited to z' > -thickness.
-  double cut_sdf(const Eigen::Vector3d& p) const {
-    double d = 0.0, zr = 0.0;
-    section(p, d, zr);
-    const double slot = d - half_gap;
-    const double vee = (d - k * (zr + groove.depth) - half_gap) * wall_norm;
-    return std::max(std::min(slot, vee), -groove.thickness - zr);
-  }
-
-  double body_sdf(const Eigen::Vector3d& p) const {
-    if (body == Body::kBox) {
-      const Eigen::Vector3d centre = 0.5 * (box_min + box_max);
-      const Eigen::Vector3d half = 0.5 * (box_max - box_min);
-      const Eigen::Vector3d q = (p - centre).cwiseAbs() - half;
-      return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
-    }
-    const double rho = pipe_rho(p);
-    return std::max({rho - pipe_radius, pipe_inner - rho, std::abs(p.x()) - pipe_half_length});
-  }
-
-  double sdf(const Eigen::Vector3d& p) const { return std::max(body_sdf(p), -cut_sdf(p)); }
-
-  // Outward normal of the body's face at p (p on the body's surface).
-  Eigen::Vector3d body_normal(const Eigen::Vector3d& p) const {
-    if (body == Body::kBox) {
-      const Eigen::Vector3d centre = 0.5 * (box_min + box_max);
-      const Eigen::Vector3d half = 0.5 * (box_max - box_min);
-      const Eigen::Vector3d q = (p - centre).cwiseAbs() - half;
-      int axis = 0;
-      q.maxCoeff(&axis);
-      Eigen::Vector3d n = Eigen::Vector3d::Zero();
-      n[axis] = p[axis] < centre[axis] ? -1.0 : 1.0;
-      return n;
-    }
-    const double rho = pipe_rho(p);
-    const double outer = rho - pipe_radius, inner = pipe_inner - rho;
-    const double end = std::abs(p.x()) - pipe_half_length;
-    if (end >= outer && end >= inner) return {p.x() < 0 ? -1.0 : 1.0, 0.0, 0.0};
-    const Eigen::Vector3d radial(0.0, p.y() / rho, (p.z() - pipe_axis_z) / rho);
-    return outer >= inner ? radial : Eigen::Vector3d(-radial);
-  }
-
-  Eigen::Vector3d gradient(const Eigen::Vector3d& p) const {
-    // Central differences: the bound is exact (a true distance) near faces, so its gradient
-    // there is the face normal.
-    constexpr double h = 1e-6;
-    Eigen::Vector3d g;
-    for (int a = 0; a < 3; ++a) {
-      Eigen::Vector3d e = Eigen::Vector3d::Zero();
-      e[a] = h;
-      g[a] = sdf(p + e) - sdf(p - e);
-    }
-    const double n = g.norm();
-    return n > 0 ? Eigen::Vector3d(g / n) : Eigen::Vector3d::UnitZ();
-  }
-
-  bool in_footprint(const Eigen::Vector2d& p) const {
-    return p.x() >= box_min.x() && p.x() <= box_max.x() && p.y() >= box_min.y() &&
-           p.y() <= box_max.y();
-  }
-
-  std::uint8_t table_label(const Eigen::Vector3d& p) const {
-    if (!gap_to_table || !in_footprint(p.head<2>())) return 0;
-    return path_distance(p.head<2>()) < half_gap ? 1 : 0;
-  }
-
-  // Entry and exit of the ray in the bounding box (slab method).
-  bool clip(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double& t0, double& t1) const {
-    t0 = -kInf;
-    t1 = kInf;
-    for (int a = 0; a < 3; ++a) {
-      if (dir[a] == 0.0) {
-        if (o[a] < box_min[a] || o[a] > box_max[a]) return false;
-        continue;
-      }
-      double ta = (box_min[a] - o[a]) / dir[a];
-      double tb = (box_max[a] - o[a]) / dir[a];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-    }
-    return t0 <= t1;
-  }
-
-  void build(Shape shape);
-  std::vector<std::vector<Eigen::Vector2d>> sample_path(const Path& path) const;
-
-  // First t in [t0, t1] where the ray is inside the solid; NaN if none.
-  double march(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double t0, double t1) const {
-    double t = t0;
-    double f = sdf(o + t * dir);
-    if (f <= 0.0) return t;
-    for (int i = 0; i < kMaxSteps && t < t1; ++i) {
-      const double t_next = std::min(t + std::max(f, kMinStep), t1);
-      const double f_next = sdf(o + t_next * dir);
-      if (f_next <= 0.0) {
-        double lo = t, hi = t_next;  // f(lo) > 0 >= f(hi)
-        while (hi - lo > kBisectTolerance) {
-          const double mid = 0.5 * (lo + hi);
-          (sdf(o + mid * dir) <= 0.0 ? hi : lo) = mid;
-        }
-        return hi;
-      }
-      t = t_next;
-      f = f_next;
-    }
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-};
+using namespace synth_detail;
 
 // Builds the workpiece of a shape. Dimensions are fixed per shape (metres); the groove's
 // cross-section comes from the params.
 void SynthScene::Impl::build(Shape shape) {
   Impl& s = *this;
+  const double pipe_radius = s.pipe_radius;  // set by the constructor
   const double t = s.groove.thickness;
   const auto plate = [&](double half_x, double half_y) {
     s.body = Body::kBox;
@@ -283,7 +35,7 @@ void SynthScene::Impl::build(Shape shape) {
   };
   const auto pipe = [&](Profile profile, double half_length) {
     s.body = Body::kPipe;
-    s.pipe_radius = 0.05;
+    s.pipe_radius = pipe_radius;
     s.pipe_inner = s.pipe_radius - t;
     s.pipe_half_length = half_length;
     s.pipe_axis_z = s.pipe_radius;  // lying on the table
@@ -382,6 +134,29 @@ GrooveGeometry groove_geometry(const SynthParams& params) {
   GrooveGeometry g;
   g.top_width = params.groove_width;
   g.root_gap = params.root_gap;
+  g.misalignment = params.misalignment;
+  if (params.joint == JointType::kFillet || params.joint == JointType::kLap) {
+    // The weld's isosceles right triangle in the 90 deg corner: its face (hypotenuse) is the
+    // top width, its throat the depth; the parts touch, there is no gap.
+    g.root_gap = 0.0;
+    g.depth = 0.5 * params.groove_width;
+    g.included_angle_deg = 90.0;
+    g.thickness = std::max(0.010, params.groove_width / std::sqrt(2.0) + 0.0015);
+    return g;
+  }
+  if (params.joint == JointType::kBevel) {
+    // One vertical wall: the inclined wall alone runs the width less the gap.
+    const double run = params.groove_width - params.root_gap;
+    if (params.groove_depth > 0.0) {
+      g.depth = params.groove_depth;
+      g.included_angle_deg = std::atan(run / g.depth) * 180.0 / kPi;
+    } else {
+      g.included_angle_deg = params.groove_angle_deg;
+      g.depth = run / std::tan(deg_to_rad(params.groove_angle_deg));
+    }
+    g.thickness = std::max(0.010, g.depth + 0.0015);
+    return g;
+  }
   const double run = 0.5 * (params.groove_width - params.root_gap);
   if (params.groove_depth > 0.0) {
     g.depth = params.groove_depth;
@@ -400,10 +175,42 @@ SynthScene::SynthScene(const SynthParams& params) : impl_(std::make_unique<Impl>
   s.half_gap = 0.5 * s.groove.root_gap;
   s.k = 0.5 * (s.groove.top_width - s.groove.root_gap) / s.groove.depth;
   s.wall_norm = 1.0 / std::sqrt(1.0 + s.k * s.k);
+  s.pipe_radius = 0.5 * params.pipe_diameter;
   s.build(params.shape);
+  s.bounds_min = s.box_min;
+  s.bounds_max = s.box_max;
+  s.setup_joint(params);
 }
 
 SynthScene::~SynthScene() = default;
+
+void SynthScene::Impl::classify(const Eigen::Vector3d& p, RayHit& hit) const {
+  const Impl& s = *this;
+  if (!s.tacks.empty() || !s.blocks.empty()) {
+    // The surface is that of the part whose bound is lowest there: a block (label 0), a tack
+    // (1, it sits in the joint) or the workpiece.
+    const double base = s.base_sdf(p), tack = s.tacks_sdf(p), block = s.blocks_sdf(p);
+    if (block < base && block <= tack) {
+      hit.label = 0;
+      hit.normal = s.gradient(p);
+      return;
+    }
+    if (tack < base) {
+      hit.label = 1;
+      hit.normal = s.gradient(p);
+      return;
+    }
+  }
+  if (!s.plain) {
+    hit.label = s.joint_label(p);
+    hit.normal = s.gradient(p);
+    return;
+  }
+  // The groove's faces are where the cut, not the body, bounds the solid; the body's faces
+  // have analytic normals, the cut's come from the distance bound's gradient.
+  hit.label = -s.cut_sdf(p) >= s.body_sdf(p) ? 1 : 0;
+  hit.normal = hit.label ? s.gradient(p) : s.body_normal(p);
+}
 
 RayHit SynthScene::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                              double t_max) const {
@@ -422,10 +229,7 @@ RayHit SynthScene::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3
         hit.hit = true;
         hit.t = t;
         hit.point = origin + t * direction;
-        // The groove's faces are where the cut, not the body, bounds the solid; the body's
-        // faces have analytic normals, the cut's come from the distance bound's gradient.
-        hit.label = -s.cut_sdf(hit.point) >= s.body_sdf(hit.point) ? 1 : 0;
-        hit.normal = hit.label ? s.gradient(hit.point) : s.body_normal(hit.point);
+        s.classify(hit.point, hit);
         return hit;
       }
     }
@@ -467,22 +271,34 @@ const GrooveGeometry& SynthScene::groove() const { return impl_->groove; }
 std::vector<Seam> SynthScene::seams() const {
   const Impl& s = *impl_;
   std::vector<Seam> seams;
-  const auto add = [&seams](Seam seam) {
+  // Per seam, the direction across it towards its +s side (the seam's left), for the joints
+  // whose root frame is not symmetric.
+  std::vector<std::vector<Eigen::Vector3d>> lefts;
+  const bool oriented = s.joint != JointType::kV;
+  const auto add = [&](Seam seam, std::vector<Eigen::Vector3d> left) {
     seam.in_view.assign(seam.root.size(), 1);
     seams.push_back(std::move(seam));
+    lefts.push_back(std::move(left));
   };
-  const double depth = s.groove.depth;
+  // Fillet and lap roots are the corner on the top surface; V and bevel roots lie D below it.
+  const bool corner = s.joint == JointType::kFillet || s.joint == JointType::kLap;
+  const double depth = corner ? 0.0 : s.groove.depth;
   switch (s.profile) {
     case Profile::kPath:
       for (const Path& path : s.paths) {
         for (const auto& run : s.sample_path(path)) {
           Seam seam;
+          std::vector<Eigen::Vector3d> left;
           for (const Eigen::Vector2d& p : run) {
             seam.root.emplace_back(p.x(), p.y(), s.top_z - depth);
             seam.normal.push_back(Eigen::Vector3d::UnitZ());
             seam.bisector.push_back(Eigen::Vector3d::UnitZ());
+            if (oriented) {
+              const Eigen::Vector2d t = path_tangent(path, p);
+              left.emplace_back(-t.y(), t.x(), 0.0);
+            }
           }
-          add(std::move(seam));
+          add(std::move(seam), std::move(left));
         }
       }
       break;
@@ -499,7 +315,7 @@ std::vector<Seam> SynthScene::seams() const {
         seam.normal.push_back(radial);
         seam.bisector.push_back(radial);
       }
-      add(std::move(seam));
+      add(std::move(seam), std::vector<Eigen::Vector3d>(n + 1, Eigen::Vector3d::UnitX()));
       break;
     }
     case Profile::kAxial: {
@@ -511,11 +327,37 @@ std::vector<Seam> SynthScene::seams() const {
         seam.normal.push_back(Eigen::Vector3d::UnitZ());
         seam.bisector.push_back(Eigen::Vector3d::UnitZ());
       }
-      add(std::move(seam));
+      add(std::move(seam), std::vector<Eigen::Vector3d>(n + 1, Eigen::Vector3d::UnitY()));
       break;
     }
   }
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    seams[k].joint = s.joint;
+    if (oriented) s.orient_seam(seams[k], lefts[k]);
+    if (k < s.seam_tacks.size()) seams[k].tacks = s.seam_tacks[k];
+  }
   return seams;
+}
+
+const char* joint_name(JointType joint) {
+  switch (joint) {
+    case JointType::kV:
+      return "V";
+    case JointType::kBevel:
+      return "bevel";
+    case JointType::kFillet:
+      return "fillet";
+    case JointType::kLap:
+      return "lap";
+  }
+  return "?";
+}
+
+JointType parse_joint(const std::string& name) {
+  if (name == "v") return JointType::kV;
+  for (JointType j : {JointType::kV, JointType::kBevel, JointType::kFillet, JointType::kLap})
+    if (name == joint_name(j)) return j;
+  throw UsageError("unknown joint '" + name + "' (expected v|bevel|fillet|lap)");
 }
 
 const char* shape_name(Shape shape) {

@@ -55,6 +55,13 @@ json params_json(const SynthParams& p) {
       {"noise", p.noise},
       {"effects", effects_string(p.effects)},
       {"depth_unit_m", p.depth_unit},
+      {"joint", joint_name(p.joint)},
+      {"misalignment_m", p.misalignment},
+      {"tacks", p.tacks},
+      {"tack_height_fraction", p.tack_height_fraction},
+      {"clamps", p.clamps},
+      {"clutter", p.clutter},
+      {"pipe_diameter_m", p.pipe_diameter},
       {"sensor",
        {{"hfov_deg", m.hfov_deg},
         {"vfov_deg", m.vfov_deg},
@@ -90,6 +97,15 @@ SynthParams params_from_json(const json& j) {
   p.noise = j.at("noise").get<bool>();
   p.effects = parse_effects(j.at("effects").get<std::string>());
   p.depth_unit = j.at("depth_unit_m").get<double>();
+  // Issue 12's parameters; older truth files have none of them (the defaults).
+  const SynthParams defaults;
+  p.joint = parse_joint(j.value("joint", std::string(joint_name(defaults.joint))));
+  p.misalignment = j.value("misalignment_m", defaults.misalignment);
+  p.tacks = j.value("tacks", defaults.tacks);
+  p.tack_height_fraction = j.value("tack_height_fraction", defaults.tack_height_fraction);
+  p.clamps = j.value("clamps", defaults.clamps);
+  p.clutter = j.value("clutter", defaults.clutter);
+  p.pipe_diameter = j.value("pipe_diameter_m", defaults.pipe_diameter);
   const json& s = j.at("sensor");
   SensorModel& m = p.sensor;
   m.hfov_deg = s.at("hfov_deg").get<double>();
@@ -123,6 +139,13 @@ Seam seam_from_json(const json& s, const std::string& path) {
   for (const json& v : s.at("normal")) seam.normal.push_back(to_vec(v));
   for (const json& v : s.at("bisector")) seam.bisector.push_back(to_vec(v));
   seam.in_view = s.at("in_view").get<std::vector<std::uint8_t>>();
+  // Older truth files: a V without tacks.
+  seam.joint = parse_joint(s.value("joint", std::string("V")));
+  if (s.contains("tacks")) {
+    for (const json& t : s.at("tacks"))
+      seam.tacks.push_back({t.at("position_m").get<double>(), to_vec(t.at("centre")),
+                            t.at("length_m").get<double>(), t.at("height_m").get<double>()});
+  }
   if (seam.normal.size() != seam.root.size() || seam.bisector.size() != seam.root.size() ||
       seam.in_view.size() != seam.root.size())
     throw InputError("truth: " + path + ": seam arrays differ in length");
@@ -141,6 +164,7 @@ void truth_from_json(const json& j, const std::string& path, SynthTruth& truth) 
   truth.groove.included_angle_deg = g.at("included_angle_deg").get<double>();
   truth.groove.root_gap = g.at("root_gap_m").get<double>();
   truth.groove.thickness = g.at("thickness_m").get<double>();
+  truth.groove.misalignment = g.value("misalignment_m", 0.0);
   const json& c = j.at("camera");
   truth.camera.width = c.at("width").get<int>();
   truth.camera.height = c.at("height").get<int>();
@@ -179,6 +203,36 @@ void read_labels(const std::string& path, SynthTruth& truth) {
   }
 }
 
+json seam_json(const Seam& s, const GrooveGeometry& g) {
+  json root = json::array(), normal = json::array(), bisector = json::array();
+  for (std::size_t k = 0; k < s.root.size(); ++k) {
+    root.push_back(vec(s.root[k]));
+    normal.push_back(vec(s.normal[k]));
+    bisector.push_back(vec(s.bisector[k]));
+  }
+  json tacks = json::array();
+  for (const Tack& t : s.tacks)
+    tacks.push_back({{"position_m", t.position},
+                     {"centre", vec(t.centre)},
+                     {"length_m", t.length},
+                     {"height_m", t.height}});
+  return {{"closed", s.closed},
+          {"joint", joint_name(s.joint)},
+          {"geometry",
+           {{"top_width_m", g.top_width},
+            {"depth_m", g.depth},
+            {"included_angle_deg", g.included_angle_deg},
+            {"root_gap_m", g.root_gap},
+            {"misalignment_m", g.misalignment}}},
+          {"tacks", tacks},
+          {"length_m", s.length()},
+          {"length_in_view_m", s.length_in_view()},
+          {"root", root},
+          {"normal", normal},
+          {"bisector", bisector},
+          {"in_view", s.in_view}};
+}
+
 }  // namespace
 
 SynthFiles synth_files(const std::string& scan_path) {
@@ -200,21 +254,7 @@ std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
     labelled_valid += truth.label[i] && truth.valid[i] ? 1 : 0;
   }
   json seams = json::array();
-  for (const Seam& s : truth.seams) {
-    json root = json::array(), normal = json::array(), bisector = json::array();
-    for (std::size_t k = 0; k < s.root.size(); ++k) {
-      root.push_back(vec(s.root[k]));
-      normal.push_back(vec(s.normal[k]));
-      bisector.push_back(vec(s.bisector[k]));
-    }
-    seams.push_back({{"closed", s.closed},
-                     {"length_m", s.length()},
-                     {"length_in_view_m", s.length_in_view()},
-                     {"root", root},
-                     {"normal", normal},
-                     {"bisector", bisector},
-                     {"in_view", s.in_view}});
-  }
+  for (const Seam& s : truth.seams) seams.push_back(seam_json(s, truth.groove));
   const Eigen::Matrix4d T = truth.T_workpiece_camera.matrix();
   json pose = json::array();
   for (int r = 0; r < 4; ++r) pose.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
@@ -232,7 +272,8 @@ std::string truth_json(const SynthTruth& truth, const std::string& scan_name,
         {"depth_m", g.depth},
         {"included_angle_deg", g.included_angle_deg},
         {"root_gap_m", g.root_gap},
-        {"thickness_m", g.thickness}}},
+        {"thickness_m", g.thickness},
+        {"misalignment_m", g.misalignment}}},
       {"camera",
        {{"width", c.width},
         {"height", c.height},
