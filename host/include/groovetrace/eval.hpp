@@ -69,6 +69,12 @@ struct EvalMetrics {
   double points_per_second = 0;                          ///< points / runtime; NaN if unknown
   std::vector<std::pair<std::string, double>> stage_ms;  ///< per stage, as reported
 
+  // The joint: the truth's (its first seam's; "V", "bevel", "fillet" or "lap") and the one the
+  // run reports for its first exported seam (report.json robust.seams[k].joint of the entry
+  // whose "file" is "trajectory.csv"); empty when the run reports none.
+  std::string joint_expected;
+  std::string joint_found;
+
   std::vector<std::string> notes;  ///< caveats (frame, missing files)
 };
 
@@ -87,6 +93,7 @@ struct RunOutput {
   std::string frame = "camera";  ///< trajectory.json "frame" when present
   double total_ms = 0;           ///< report.json end-to-end time; NaN if absent
   std::vector<std::pair<std::string, double>> stage_ms;  ///< report.json stage timings
+  std::string joint;  ///< report.json robust.seams[k].joint of trajectory.csv's seam; "" if none
 };
 
 /// Reads annotated.pcd (a PCD of any DATA kind with a `groove` field), trajectory.csv (header

@@ -187,6 +187,7 @@ EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& d
   score_coverage(truth.seams, poses, options, m);
   m.runtime_ms = kNaN;
   m.points_per_second = kNaN;
+  m.joint_expected = joint_name(truth.seams.empty() ? truth.params.joint : truth.seams[0].joint);
   return m;
 }
 
@@ -229,6 +230,10 @@ std::string metrics_json(const EvalMetrics& m, const std::string& truth,
        {{"total_ms", m.runtime_ms},
         {"points_per_second", m.points_per_second},
         {"stages_ms", stages}}},
+      {"joint_expected", m.joint_expected},
+      {"joint_found", m.joint_found.empty() ? json(nullptr) : json(m.joint_found)},
+      {"joint_match",
+       m.joint_found.empty() ? json(nullptr) : json(m.joint_found == m.joint_expected)},
       {"notes", m.notes},
   };
   return j.dump(2) + "\n";
@@ -267,6 +272,9 @@ std::string metrics_summary(const EvalMetrics& m) {
                   m.points_per_second);
     s += buf;
   }
+  if (!m.joint_found.empty())
+    s += "joint: expected " + m.joint_expected + ", found " + m.joint_found +
+         (m.joint_found == m.joint_expected ? " (match)\n" : " (mismatch)\n");
   for (const std::string& note : m.notes) s += "note: " + note + "\n";
   return s;
 }

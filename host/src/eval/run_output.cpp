@@ -126,6 +126,20 @@ void read_report(const nlohmann::json& j, RunOutput& out) {
   }
 }
 
+// The joint the detector reports for the first exported seam: the robust.seams entry whose
+// "file" is "trajectory.csv".
+void read_report_joint(const nlohmann::json& j, RunOutput& out) {
+  if (!j.is_object() || !j.contains("robust") || !j["robust"].is_object()) return;
+  const nlohmann::json& robust = j["robust"];
+  if (!robust.contains("seams") || !robust["seams"].is_array()) return;
+  for (const nlohmann::json& seam : robust["seams"]) {
+    if (!seam.is_object() || !seam.contains("file") || seam["file"] != "trajectory.csv") continue;
+    if (seam.contains("joint") && seam["joint"].is_string())
+      out.joint = seam["joint"].get<std::string>();
+    return;
+  }
+}
+
 }  // namespace
 
 RunOutput read_run_output(const std::string& result_dir) {
@@ -147,7 +161,10 @@ RunOutput read_run_output(const std::string& result_dir) {
   }
   if (read_file(dir + "report.json", bytes)) {
     const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
-    if (!j.is_discarded()) read_report(j, out);
+    if (!j.is_discarded()) {
+      read_report(j, out);
+      read_report_joint(j, out);
+    }
   }
   return out;
 }
@@ -177,6 +194,7 @@ EvalMetrics evaluate_files(const std::string& scan_path, const std::string& resu
   m.points_per_second =
       std::isfinite(total) && total > 0.0 ? static_cast<double>(m.points) / (total * 1e-3) : kNaN;
   m.stage_ms = run.stage_ms;
+  m.joint_found = run.joint;
   return m;
 }
 
