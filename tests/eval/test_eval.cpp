@@ -13,8 +13,10 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/eval.hpp>
 #include <groovetrace/synth.hpp>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace gt = groovetrace;
@@ -226,6 +228,59 @@ TEST(Eval, ReadsARunDirectory) {
   std::ofstream(dir / "out" / "trajectory.json") << R"({"frame": "base"})";
   EXPECT_FALSE(gt::evaluate_files(scan_path, (dir / "out").string()).notes.empty());
   EXPECT_THROW(gt::evaluate_files(scan_path, (dir / "nowhere").string()), gt::InputError);
+  std::filesystem::remove_all(dir);
+}
+
+// The joint a run reports for its first exported seam (report.json robust.seams, the entry
+// whose file is trajectory.csv) against the truth's.
+TEST(Eval, JointFromTheReport) {
+  gt::SynthParams p;
+  p.joint = gt::JointType::kBevel;
+  p.groove_angle_deg = 45.0;
+  p.width = 160;
+  p.height = 120;
+  p.noise = false;
+  const gt::SynthScan scan = gt::render(p);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gt-evaljoint-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "out");
+  const std::string scan_path = (dir / "scan.pcd").string();
+  gt::write_synth_scan(scan, scan_path);
+  {
+    gt::Normals normals;
+    normals.resize(scan.cloud.size());
+    const std::vector<float> descriptor(scan.cloud.size(), 1.0f);
+    gt::write_file_atomic(
+        (dir / "out" / "annotated.pcd").string(),
+        gt::annotated_pcd_bytes(scan.cloud, {&normals, &descriptor, &scan.truth.label}));
+  }
+  const auto metrics = [&](const std::string& report) {
+    std::ofstream(dir / "out" / "report.json") << report;
+    const gt::EvalMetrics m = gt::evaluate_files(scan_path, (dir / "out").string());
+    return std::make_pair(m, nlohmann::json::parse(gt::metrics_json(m, scan_path, "out")));
+  };
+  // The second seam is the first exported one; the other's joint is not taken.
+  auto [m, j] = metrics(R"({"robust": {"seams": [{"file": "trajectory_2.csv", "joint": "V"},
+                                                 {"file": "trajectory.csv", "joint": "bevel"}]}})");
+  EXPECT_EQ(m.joint_expected, "bevel");
+  EXPECT_EQ(m.joint_found, "bevel");
+  EXPECT_EQ(j.at("joint_expected"), "bevel");
+  EXPECT_EQ(j.at("joint_found"), "bevel");
+  EXPECT_EQ(j.at("joint_match"), true);
+  EXPECT_NE(gt::metrics_summary(m).find("joint: expected bevel, found bevel (match)"),
+            std::string::npos);
+  std::tie(m, j) =
+      metrics(R"({"robust": {"seams": [{"file": "trajectory.csv", "joint": "fillet"}]}})");
+  EXPECT_EQ(j.at("joint_found"), "fillet");
+  EXPECT_EQ(j.at("joint_match"), false);
+  // No joint reported (older runs): null, not a mismatch.
+  for (const char* report : {R"({"robust": {"seams": [{"file": "trajectory.csv"}]}})",
+                             R"({"timings_ms": {"total": 3.0}})", "not json"}) {
+    std::tie(m, j) = metrics(report);
+    EXPECT_EQ(j.at("joint_expected"), "bevel") << report;
+    EXPECT_TRUE(j.at("joint_found").is_null()) << report;
+    EXPECT_TRUE(j.at("joint_match").is_null()) << report;
+  }
   std::filesystem::remove_all(dir);
 }
 
