@@ -25,7 +25,8 @@ enum class Shape {
   kStraight,  ///< butt V-groove straight across a 300 x 200 mm plate lying on the table
   kCurve,     ///< V-groove along an S curve (two tangent arcs) in the same plate
   kBox,       ///< straight groove across the top of a raised 160 x 100 x 60 mm block
-  kCylinder,  ///< circumferential groove around a 100 mm pipe lying on the table
+  kCylinder,  ///< circumferential groove around a pipe (SynthParams::pipe_diameter, 100 mm)
+              ///< lying on the table
   kPipeLong,  ///< longitudinal groove along the top of the same pipe
   kLShape,    ///< a seam with a 90 degree corner in the plate
   kMulti,     ///< two parallel straight grooves, 80 mm apart, in the plate
@@ -101,7 +102,8 @@ struct SensorModel {
 /// Everything that determines a synthetic scan. Lengths in metres, angles in degrees.
 struct SynthParams {
   Shape shape = Shape::kStraight;
-  double groove_width = 0.010;     ///< top width of the V between its two top edges (m)
+  double groove_width = 0.010;     ///< top width of the V between its two top edges (m);
+                                   ///< bevel, fillet, lap: GrooveGeometry
   double groove_angle_deg = 60.0;  ///< included angle between the two walls (deg)
   double groove_depth = 0.0;       ///< depth of the V (m); > 0 overrides groove_angle_deg
   double root_gap = 0.0005;        ///< gap between the two parts at the root (m)
