@@ -190,6 +190,65 @@ TEST(RobustDetect, SeamEndsStayOnThePart) {
   EXPECT_LT(worst, 0.0015);
 }
 
+// Mean distance (m) of the waypoints from the true root line and mean angle (deg) of the
+// tool z axis from the joint's own -bisector there.
+std::pair<double, double> path_errors(const Trajectory& t, const Seam& truth) {
+  double dist = 0, angle = 0;
+  for (const Waypoint& w : t.waypoints) {
+    std::size_t near = 0;
+    for (std::size_t k = 1; k < truth.root.size(); ++k) {
+      if ((truth.root[k] - w.position).norm() < (truth.root[near] - w.position).norm()) near = k;
+    }
+    dist += test::polyline_distance(truth.root, false, w.position);
+    const Eigen::Vector3d z = w.orientation.toRotationMatrix().col(2);
+    angle += std::acos(std::clamp(z.dot(-truth.bisector[near]), -1.0, 1.0)) * 180 / M_PI;
+  }
+  const double n = static_cast<double>(std::max<std::size_t>(1, t.waypoints.size()));
+  return {dist / n, angle / n};
+}
+
+// A single bevel (45 deg, 8 mm deep) seen from above: its square side returns nothing. Read
+// as a symmetric V, the path ran halfway up the inclined wall (3.7 mm across and 3.5 mm above
+// the root) with the torch 22.5 deg off the joint's bisector.
+TEST(RobustDetect, SingleBevelIsFoundAtTheFootOfItsSquareSide) {
+  SynthParams sp;
+  sp.joint = JointType::kBevel;
+  sp.groove_angle_deg = 45;
+  sp.groove_width = 0.0085;
+  sp.width = 640;
+  sp.height = 480;
+  sp.seed = 11;
+  const SynthScan scan = render(sp);
+  const RobustParams p;
+  const RobustDetection d = detect_robust(scan.cloud, p);
+  ASSERT_GT(accepted_count(d), 0u);
+  EXPECT_EQ(best_accepted(d)->joint, "bevel");
+  const auto [dist, angle] =
+      path_errors(seam_trajectory(*best_accepted(d), p), scan.truth.seams.at(0));
+  EXPECT_LT(dist, 0.0012);
+  EXPECT_LT(angle, 4.0);  // 3.1 deg here at 640x480; the issue asks 2 deg on the sweep (not met)
+}
+
+// A 100 mm wide panel joint (150 deg): ten times the width the default scale's window holds;
+// the search at a larger scale finds it.
+TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {
+  SynthParams sp;
+  sp.groove_width = 0.10;
+  sp.groove_angle_deg = 150;
+  sp.width = 640;
+  sp.height = 480;
+  sp.seed = 12;
+  const SynthScan scan = render(sp);
+  const RobustParams p;
+  const RobustDetection d = detect_robust(scan.cloud, p);
+  ASSERT_GT(accepted_count(d), 0u);
+  const SeamCandidate& s = *best_accepted(d);
+  EXPECT_GE(s.scale, 0.04 - 1e-9);
+  EXPECT_NEAR(s.width, 0.10, 0.01);
+  EXPECT_NEAR(s.opening_deg, 150, 5);
+  EXPECT_LT(path_errors(seam_trajectory(s, p), scan.truth.seams.at(0)).first, 0.0015);
+}
+
 TEST(RobustDetect, RootOfTheAnalyticVGroove) {
   // tests/scenes.hpp: 640x480 at 0.4 m, tilted and turned, 10 mm wide and 4 mm deep, no gap.
   test::VGrooveScene sc;

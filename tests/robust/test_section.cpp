@@ -89,19 +89,28 @@ TEST(RobustSection, RoundedRimsAndRootGapDoNotPullTheRoot) {
 }
 
 TEST(RobustSection, OneWallSeenKeepsTheOpeningAndRoot) {
-  // The left wall at a grazing angle returns nothing: the top ends at its rim.
+  // The left wall of a 60 deg V returns nothing. Seen from 20 deg to the left it faces the
+  // sensor at 80 deg incidence (grazing): the top ends at its rim, the V is taken symmetric.
   std::vector<Eigen::Vector2d> pts;
   const double half = 0.008 / std::tan(M_PI / 3);
   for (const auto& p : v_profile(0.008, 60, 60, 0.0, 0.0001, 3)) {
     if (p.x() > -half && p.x() < 0) continue;
     pts.push_back(p);
   }
-  const VProfile f = fit_v_profile(pts, 0.02);
+  const double tilt = 20 * M_PI / 180;
+  const VProfile f = fit_v_profile(pts, 0.02, false, {-std::sin(tilt), std::cos(tilt)});
   ASSERT_TRUE(f.ok) << f.why;
   EXPECT_TRUE(f.one_wall);
+  EXPECT_FALSE(f.square_side);
   EXPECT_NEAR(f.edge_right.x(), half, 3e-4);
   EXPECT_NEAR(f.edge_left.x(), -half, 8e-4);  // within a sample spacing
   EXPECT_NEAR(f.root.x(), 0.0, 5e-4);
+  // Seen straight down, that wall would have faced the sensor at 60 deg: it is not there, the
+  // hidden side is square and the root at its foot.
+  const VProfile above = fit_v_profile(pts, 0.02);
+  ASSERT_TRUE(above.ok) << above.why;
+  EXPECT_TRUE(above.square_side);
+  EXPECT_NEAR(above.root.x(), -half, 8e-4);
 }
 
 // A 60 deg V (depth 8 mm, no root gap) in a flat top at v = 0, seen as a D415 640x480 sees it
@@ -170,6 +179,42 @@ TEST(RobustSection, SymmetricFitKeepsTheGrazingWallsRim) {
   EXPECT_NEAR((sym.root - free.root).norm(), 0.0, 1e-5);
   EXPECT_NEAR(sym.edge_left.x(), free.edge_left.x(), 1e-5);
   EXPECT_NEAR(sym.edge_right.x(), free.edge_right.x(), 1e-5);
+}
+
+TEST(RobustSection, SquareSideUnseenFromAboveIsABevel) {
+  // A single bevel seen straight down its square side: the vertical wall returns nothing, the
+  // 45 deg wall is seen. Its mirror image would face the sensor at 45 deg and would have been
+  // seen, so the hidden side is square and the root sits at its foot, not halfway up the
+  // inclined wall (where a symmetric V would put it: 4 mm off at 8 mm depth).
+  const double depth = 0.008;
+  const VProfile f = fit_v_profile(v_profile(depth, 90, 45, 0.0, 0.0, 1), 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_TRUE(f.one_wall);
+  EXPECT_TRUE(f.square_side);
+  EXPECT_NEAR(f.root.x(), 0.0, 2e-4);
+  EXPECT_NEAR(f.root.y(), -depth, 2e-4);
+  EXPECT_GT(f.wall_left_deg, 85.0);
+  EXPECT_NEAR(f.wall_right_deg, 45.0, 1.0);
+  // The joint's own bisector: 22.5 deg from the top normal, towards the inclined wall.
+  EXPECT_NEAR(std::atan2(f.bisector.x(), f.bisector.y()) * 180 / M_PI, 22.5, 1.0);
+}
+
+TEST(RobustSection, HighLowPlatesReportTheirMisalignment) {
+  // The right plate 1.5 mm higher than the left; both walls dip 60 deg to a root 8 mm below
+  // the left top.
+  const double depth = 0.008, rise = 0.0015, k = 1 / std::tan(M_PI / 3);
+  const double ul = -depth * k, ur = (depth + rise) * k;
+  std::vector<Eigen::Vector2d> pts;
+  for (int row = 0; row < 4; ++row) {
+    for (double u = -0.02 + 0.0002 * row; u <= 0.02; u += 0.0008) {
+      double v = u < ul ? 0.0 : u > ur ? rise : u <= 0 ? -depth * (u - ul) / -ul : -depth + u / k;
+      pts.emplace_back(u, v);
+    }
+  }
+  const VProfile f = fit_v_profile(pts, 0.02);
+  ASSERT_TRUE(f.ok) << f.why;
+  EXPECT_NEAR(f.misalignment, rise, 2e-4);
+  EXPECT_NEAR(f.root.x(), 0.0, 3e-4);
 }
 
 TEST(RobustSection, CurvedTopOfAPipeIsNotAGroove) {

@@ -8,6 +8,7 @@
 #include <groovetrace/export.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace groovetrace {
 
@@ -43,6 +44,9 @@ struct RobustParams {
   /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
   /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
   double scale = 0.010;
+  /// The scales searched (m), each with voxels of max(cell, scale / 10); a groove is kept at
+  /// the scale that fits it best (docs/method-robust.md, "Scales"). Empty: `scale` alone.
+  std::vector<double> scales = {0.005, 0.010, 0.020, 0.040};
   double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
   double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
   double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)

@@ -38,6 +38,11 @@ struct GrooveSection {
   /// One wall returned (almost) nothing (seen at a grazing angle): its edge is where the top
   /// surface ends, the V taken symmetric about the top normal through the opening.
   bool one_wall = false;
+  /// With one_wall: the unseen side is square (its mirror image would have faced the sensor),
+  /// the root at its foot - a single bevel seen along its square side.
+  bool square_side = false;
+  double wall_left_deg = 0, wall_right_deg = 0;  ///< each wall's dip below the top (deg)
+  double misalignment = 0;  ///< top on the right (across) side minus the left's (m): high-low
   /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
   /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
   bool inferred = false;
@@ -67,6 +72,10 @@ struct SeamCandidate {
   double consistency = 0.0;  ///< 1 - relative spread of width and opening along the seam
   double width = 0, depth = 0, opening_deg = 0;  ///< medians (m, m, deg)
   double score = 0.0;  ///< length_mm * ok_fraction * fit_quality * consistency
+  /// "V", or "bevel" (one wall square to the top, the other inclined); docs/method-robust.md.
+  std::string joint = "V";
+  double misalignment = 0.0;  ///< median |high-low| of the tops over the ok sections (m)
+  double scale = 0.0;         ///< the search scale it was found at (m; RobustParams::scales)
   bool accepted = false;
   std::string reason;  ///< why rejected (empty when accepted)
 };
@@ -78,7 +87,20 @@ struct SeamCandidate {
 /// normal and ends where it started.
 GT_API Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
-/// Everything the robust method decided.
+/// What the search at one scale found (RobustParams::scales).
+struct ScaleSearchSummary {
+  double scale = 0.0;               ///< m
+  double cell = 0.0;                ///< voxel edge at this scale (m)
+  double threshold = 0.0;           ///< candidate concavity threshold (m)
+  std::size_t candidates = 0;       ///< voxels above the threshold
+  std::size_t nodes = 0;            ///< crease nodes
+  std::size_t confirmed_nodes = 0;  ///< nodes whose cross-section is a V
+  std::size_t seams = 0;            ///< candidate seams traced
+  std::size_t kept = 0;             ///< of those, kept after the scales' duplicates were dropped
+};
+
+/// Everything the robust method decided. The per-point fields and the counts are those of the
+/// search at RobustParams::scale; `scales` sums up every scale's search.
 struct RobustDetection {
   std::vector<std::uint8_t> groove;  ///< per input point: 1 = groove
   std::vector<float> concavity;      ///< per input point: its voxel's concavity (m), NaN
@@ -89,6 +111,7 @@ struct RobustDetection {
   std::size_t nodes = 0;             ///< crease nodes after non-maximum suppression
   std::size_t confirmed_nodes = 0;   ///< nodes whose cross-section is a V
   std::vector<SeamCandidate> seams;  ///< every candidate, best score first
+  std::vector<ScaleSearchSummary> scales;
 };
 
 /// Runs stages 1-4 on `cloud` (metres; viewpoint = the sensor origin in its frame). Never

@@ -61,4 +61,9 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
 /// across a gap of up to 3 `link`, m) and traces the joined ones again.
 void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link);
 
+/// The seams of every scale's search, ranked best first, without the ones that repeat a better
+/// seam: a seam is dropped when 30 % or more of its root line runs within half the wider of
+/// the two grooves (at least 3 mm) of a seam kept before it. Order kept.
+std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked);
+
 }  // namespace groovetrace::robust_detail

@@ -78,6 +78,76 @@ std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes&
   return seams;
 }
 
+// The widest groove a scale's window holds with top surface on both sides, per metre of scale.
+constexpr double kWidthPerScale = 1.6;
+
+// The parameters of the search at `scale` (m): the crease radius and the section window
+// follow it, and so do the voxels (a tenth of it, never finer than `cell`), so that a ball
+// holds about as many voxels at every scale.
+RobustParams at_scale(const RobustParams& params, double scale) {
+  RobustParams p = params;
+  p.scale = scale;
+  p.cell = std::max(params.cell, 0.1 * scale);
+  return p;
+}
+
+// One scale's search: candidates and crease nodes, then seams traced from them and scored.
+struct ScaleSearch {
+  RobustParams params;
+  CreaseMap map;
+  CreaseNodes nodes;
+  ScaleSearchSummary summary;
+  std::vector<SeamCandidate> seams;
+};
+
+ScaleSearch find_creases(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend) {
+  ScaleSearch out{params, crease_map(cloud, params, backend), {}, {}, {}};
+  ScaleSearchSummary& sum = out.summary;
+  sum.scale = params.scale;
+  sum.cell = params.cell;
+  sum.threshold = out.map.threshold;
+  for (float c : out.map.concavity) sum.candidates += (std::isfinite(c) && c > sum.threshold);
+  out.nodes = crease_nodes(out.map, params);
+  sum.nodes = out.nodes.voxel.size();
+  return out;
+}
+
+void trace_scale(const Cloud& cloud, ScaleSearch& search) {
+  const RobustParams& params = search.params;
+  if (search.nodes.voxel.empty()) return;
+  const Context ctx{cloud,
+                    params,
+                    search.map,
+                    NeighborGrid(voxel_cloud(search.map), static_cast<float>(params.scale)),
+                    BoxBins(cloud, 0.25 * params.scale),
+                    2 * params.scale};
+  const ConfirmedNodes confirmed = confirm_nodes(ctx, search.nodes);
+  search.summary.confirmed_nodes = confirmed.roots.size();
+  search.seams = trace_seams(ctx, confirmed, 1.5 * params.scale);
+  for (SeamCandidate& seam : search.seams) {
+    score_seam(seam, params);
+    seam.scale = params.scale;
+  }
+  search.summary.seams = search.seams.size();
+}
+
+// A seam's score as a reading of its groove at the scale it was found at: the window holds a
+// groove up to kWidthPerScale times the scale wide with top surface to spare; a wider one's
+// top was fitted on its rims or walls (the tool axis tilts with them, a wide joint reads as
+// a narrower V), so its score counts the less the more it overfills the window.
+double scale_fit_score(const SeamCandidate& seam) {
+  const double over = seam.width / (kWidthPerScale * seam.scale);
+  return over > 1 ? seam.score / (over * over) : seam.score;
+}
+
+// Accepted seams first, each group by scale_fit_score, best first.
+void rank_seams(std::vector<SeamCandidate>& seams) {
+  std::stable_sort(seams.begin(), seams.end(), [](const SeamCandidate& a, const SeamCandidate& b) {
+    if (a.accepted != b.accepted) return a.accepted;
+    return scale_fit_score(a) > scale_fit_score(b);
+  });
+}
+
 }  // namespace
 
 RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
@@ -91,32 +161,33 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               const std::function<void(const std::string&)>& lap) {
   RobustDetection det;
   det.groove.assign(cloud.size(), 0);
-  const CreaseMap map = crease_map(cloud, params, backend);
-  per_point_fields(cloud, map, det);
-  det.threshold = map.threshold;
-  det.noise_sigma = map.sigma;
-  for (float c : map.concavity) det.candidates += (std::isfinite(c) && c > map.threshold) ? 1 : 0;
-  const CreaseNodes nodes = crease_nodes(map, params);
-  det.nodes = nodes.voxel.size();
+  std::vector<double> scales = params.scales;
+  if (std::find(scales.begin(), scales.end(), params.scale) == scales.end()) {
+    scales.push_back(params.scale);
+  }
+  std::vector<ScaleSearch> searches;
+  for (double scale : scales)
+    searches.push_back(find_creases(cloud, at_scale(params, scale), backend));
   if (lap) lap("candidates");
-  if (nodes.voxel.empty()) return det;
-
-  const Context ctx{cloud,
-                    params,
-                    map,
-                    NeighborGrid(voxel_cloud(map), static_cast<float>(params.scale)),
-                    BoxBins(cloud, 0.25 * params.scale),
-                    2 * params.scale};
-  const ConfirmedNodes confirmed = confirm_nodes(ctx, nodes);
-  det.confirmed_nodes = confirmed.roots.size();
-  det.seams = trace_seams(ctx, confirmed, 1.5 * params.scale);
-  for (SeamCandidate& seam : det.seams) score_seam(seam, params);
-  // Accepted seams first, each group best score first.
-  std::stable_sort(det.seams.begin(), det.seams.end(),
-                   [](const SeamCandidate& a, const SeamCandidate& b) {
-                     if (a.accepted != b.accepted) return a.accepted;
-                     return a.score > b.score;
-                   });
+  std::vector<SeamCandidate> all;
+  for (ScaleSearch& search : searches) {
+    trace_scale(cloud, search);
+    if (search.params.scale == params.scale) {
+      per_point_fields(cloud, search.map, det);
+      det.threshold = search.map.threshold;
+      det.noise_sigma = search.map.sigma;
+      det.candidates = search.summary.candidates;
+      det.nodes = search.summary.nodes;
+      det.confirmed_nodes = search.summary.confirmed_nodes;
+    }
+    det.scales.push_back(search.summary);
+    for (SeamCandidate& seam : search.seams) all.push_back(std::move(seam));
+  }
+  rank_seams(all);
+  det.seams = robust_detail::drop_duplicate_scales(std::move(all));
+  for (ScaleSearchSummary& sum : det.scales) {
+    for (const SeamCandidate& seam : det.seams) sum.kept += (seam.scale == sum.scale);
+  }
   if (lap) lap("seams");
   det.groove = label_grooves(cloud, det.seams);
   if (lap) lap("region");

@@ -171,4 +171,38 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
   }
 }
 
+namespace {
+
+// Share of `seam`'s root line within `reach` (m) of `kept`'s (brute force: a few hundred points
+// each).
+double share_near(const SeamCandidate& seam, const SeamCandidate& kept, double reach) {
+  const auto& pts = seam.curve.points;
+  if (pts.empty()) return 0.0;
+  std::size_t near = 0;
+  for (const Eigen::Vector3d& p : pts) {
+    for (const Eigen::Vector3d& q : kept.curve.points) {
+      if ((p - q).squaredNorm() <= reach * reach) {
+        ++near;
+        break;
+      }
+    }
+  }
+  return static_cast<double>(near) / pts.size();
+}
+
+}  // namespace
+
+std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked) {
+  std::vector<SeamCandidate> kept;
+  for (SeamCandidate& seam : ranked) {
+    bool repeats = false;
+    for (const SeamCandidate& k : kept) {
+      const double reach = std::max(0.003, 0.5 * std::max(seam.width, k.width));
+      repeats = repeats || share_near(seam, k, reach) >= 0.3;
+    }
+    if (!repeats) kept.push_back(std::move(seam));
+  }
+  return kept;
+}
+
 }  // namespace groovetrace::robust_detail

@@ -21,6 +21,30 @@ double relative_spread(const std::vector<double>& v) {
   return mad_sigma(v, med) / med;
 }
 
+// A single bevel has one side square to the top (its dip over 75 deg: a wall measured steep
+// or a hidden side whose mirror image would have been seen) and the other at least 20 deg
+// flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
+std::string joint_kind(const std::vector<GrooveSection>& secs) {
+  std::vector<double> steep, flat;
+  for (const GrooveSection& s : secs) {
+    if (!s.ok) continue;
+    steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
+    flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
+  }
+  if (steep.size() < 3) return "V";
+  const double hi = upper_median(steep), lo = upper_median(flat);
+  return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";
+}
+
+// Median |high-low| of the two-wall sections' top sides (m); 0 with none.
+double median_misalignment(const std::vector<GrooveSection>& secs) {
+  std::vector<double> m;
+  for (const GrooveSection& s : secs) {
+    if (s.ok && !s.one_wall) m.push_back(std::abs(s.misalignment));
+  }
+  return m.empty() ? 0.0 : upper_median(m);
+}
+
 }  // namespace
 
 void score_seam(SeamCandidate& seam, const RobustParams& params) {
@@ -43,6 +67,8 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
   seam.consistency =
       width.empty() ? 0.0 : std::max(0.0, 1.0 - relative_spread(width) - relative_spread(opening));
   seam.score = seam.length * 1000.0 * seam.ok_fraction * seam.fit_quality * seam.consistency;
+  seam.joint = joint_kind(seam.sections);
+  seam.misalignment = median_misalignment(seam.sections);
 
   seam.accepted = false;
   if (width.size() < 3) {
@@ -53,7 +79,7 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
     seam.reason = "fewer than 40 % of the sections are V-shaped";
   } else if (seam.consistency < 0.35) {
     seam.reason = "width or opening varies along the seam";
-  } else if (seam.opening_deg < 15 || seam.opening_deg > 160) {
+  } else if (seam.opening_deg < 15 || seam.opening_deg > 175) {
     seam.reason = "implausible opening angle";
   } else {
     seam.accepted = true;

@@ -131,7 +131,11 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
     return sec;
   }
   sec.support = static_cast<int>(pr.uv.size());
-  const VProfile f = fit_v_profile(thinned(pr), half_window, symmetric);
+  const Eigen::Vector3d to_sensor = cloud.viewpoint.cast<double>() - origin;
+  const Eigen::Vector2d view(to_sensor.dot(pr.a), to_sensor.dot(pr.n));
+  const VProfile f =
+      fit_v_profile(thinned(pr), half_window, symmetric,
+                    view.norm() > 0 ? Eigen::Vector2d(view.normalized()) : Eigen::Vector2d(0, 1));
   auto to3 = [&](const Eigen::Vector2d& p) { return pr.at(origin, p.x(), p.y()); };
   sec.tangent = pr.t;
   sec.ok = f.ok;
@@ -150,6 +154,10 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
   sec.rms = f.rms;
   sec.noise = f.noise;
   sec.one_wall = f.one_wall;
+  sec.square_side = f.square_side;
+  sec.wall_left_deg = f.wall_left_deg;
+  sec.wall_right_deg = f.wall_right_deg;
+  sec.misalignment = f.misalignment;
   return sec;
 }
 

@@ -71,6 +71,11 @@ struct VProfile {
   /// One wall returned (almost) nothing (seen at a grazing angle): that wall's edge is where the
   /// top surface ends, the V taken symmetric about the top normal through the opening.
   bool one_wall = false;
+  /// With one_wall: the unseen side is square (its mirror image would have faced the sensor),
+  /// the root at its foot - a single bevel seen along its square side.
+  bool square_side = false;
+  /// The right top side's height minus the left's above the root (m): plates set high-low.
+  double misalignment = 0.0;
 };
 
 /// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
@@ -84,8 +89,10 @@ struct VProfile {
 /// fit, the walls are refitted with equal dips about the top normal through the root, so a
 /// poorly sampled wall (a grazing view puts two image rows on it) takes its slope from the
 /// other and only its offset from its own points.
+/// `view`: unit direction towards the sensor in profile coordinates (it tells a wall hidden at a
+/// grazing angle from a square side that cannot be seen).
 VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window,
-                       bool symmetric = false);
+                       bool symmetric = false, const Eigen::Vector2d& view = Eigen::Vector2d(0, 1));
 
 /// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
 /// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)

@@ -262,7 +262,7 @@ void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
   if (depths.size() < 3) return;
   const double depth = upper_median(depths);
   for (auto& s : secs) {
-    if (!s.ok || !s.one_wall) continue;
+    if (!s.ok || !s.one_wall || s.square_side) continue;
     const Eigen::Vector3d centre = 0.5 * (s.edge_left + s.edge_right);
     s.root = centre - depth * s.normal;
     s.depth = depth;
@@ -278,11 +278,12 @@ void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
 constexpr double kSymmetricDeg = 8.0;
 
 // The seam's asymmetry (rad, about the tangent, from top normal to bisector): the median over
-// its two-wall sections; NaN with fewer than three.
+// its two-wall sections and those one-wall sections whose hidden side is square (their
+// bisector is measured, not assumed); NaN with fewer than three.
 double seam_asymmetry(const std::vector<GrooveSection>& secs) {
   std::vector<double> asym;
   for (const auto& s : secs) {
-    if (!s.ok || s.one_wall) continue;
+    if (!s.ok || (s.one_wall && !s.square_side)) continue;
     asym.push_back(std::atan2(s.normal.cross(s.bisector).dot(s.tangent), s.normal.dot(s.bisector)));
   }
   if (asym.size() < 3) return NAN;

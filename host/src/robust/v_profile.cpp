@@ -339,6 +339,16 @@ PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m,
 
 // A two-wall V needs this many points on each wall; a one-wall V twice as many on its wall.
 constexpr int kMinWall = 4;
+// A wall may dip into the material up to a little past vertical (a single bevel's square side,
+// measured with noise); beyond, it overhangs. A step down to a table is told by its two top
+// sides at different heights, not by its dip.
+constexpr double kMaxDipDeg = 95.0;
+// The two top sides may differ in height by this share of the depth (plates set high-low);
+// more is a step or a channel between two parts (a bar lying beside a plate).
+constexpr double kMaxStepShare = 0.3;
+// A wall facing the sensor at less than this incidence returns points (the D415 drops out from
+// about 75 deg).
+constexpr double kShownIncidenceDeg = 65.0;
 
 // What the steps of one profile's fit share: the window's points and the scales the top
 // surface's noise sets (all in m).
@@ -350,7 +360,8 @@ struct ProfileFit {
   double tau = 0;                      // points within tau of the top are top
   double scale = 0;                    // Tukey scale of the V fit
   double vertex_zone = 0;              // points this near a vertex stay out of the fits
-  double top_step = 0;                 // height step between the two top sides' lines
+  double top_step = 0;                 // right top side's line minus the left's at u = 0
+  Eigen::Vector2d view{0, 1};          // unit, towards the sensor
 };
 
 // 1. The top surface `q` from the outer half of the window. A quadratic needs both sides; its
@@ -438,14 +449,15 @@ VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector
 
 // Each side's top on its own, as a line from the outer half: a real groove's two top sides
 // continue each other (curved or not, their lines meet above the centre at one height); a
-// step down to a table fitted by one tilted line does not. The two lines' height difference
-// at u = 0 (m); 0 without three points on each side.
+// step down to a table fitted by one tilted line does not, and plates set high-low differ by
+// their misalignment. The right line's height minus the left's at u = 0 (m); 0 without three
+// points on each side.
 double top_step(const std::vector<Eigen::Vector2d>& outer) {
   std::vector<Eigen::Vector2d> lo, hi;
   for (const auto& p : outer) (p.x() < 0 ? lo : hi).push_back(p);
   if (lo.size() < 3 || hi.size() < 3) return 0;
   const Eigen::Vector3d ql = fit_poly(lo, 1).first, qr = fit_poly(hi, 1).first;
-  return std::abs(ql[0] - qr[0]);
+  return qr[0] - ql[0];
 }
 
 // The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
@@ -483,8 +495,8 @@ VProfile describe_v(const VModel& v, const PieceStats& st, double fallback_noise
 const char* why_not_v(const VProfile& o, const PieceStats& st, const ProfileFit& f, int wall_min) {
   const Eigen::Vector2d &el = o.edge_left, &er = o.edge_right;
   if (!o.root.allFinite() || !el.allFinite() || !er.allFinite()) return "V fit did not converge";
-  if (o.wall_left_deg < 8 || o.wall_right_deg < 8) return "a wall is too flat";
-  if (o.wall_left_deg > 86 || o.wall_right_deg > 86) return "a wall is vertical or overhangs";
+  if (o.wall_left_deg < 3 || o.wall_right_deg < 3) return "a wall is too flat";
+  if (o.wall_left_deg > kMaxDipDeg || o.wall_right_deg > kMaxDipDeg) return "a wall overhangs";
   if (o.top_left < 3 || o.top_right < 3) return "a top surface is missing";
   if (o.wall_left < wall_min || o.wall_right < wall_min) return "a wall is missing";
   if (o.depth < 1.5 * f.tau) return "too shallow for the noise";
@@ -493,7 +505,7 @@ const char* why_not_v(const VProfile& o, const PieceStats& st, const ProfileFit&
   }
   if (o.rms > 0.35 * o.depth) return "walls are not straight";
   if (st.top_outliers > 0.5) return "top surfaces disagree";
-  if (f.top_step > std::max(2 * f.tau, 0.5 * o.depth)) {
+  if (std::abs(f.top_step) > std::max(2 * f.tau, kMaxStepShare * o.depth)) {
     return "top surfaces at different heights (a step)";
   }
   return nullptr;
@@ -505,6 +517,7 @@ VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   const PieceStats st = piece_stats(f.pts, v, f.scale, f.vertex_zone);
   VProfile o = describe_v(v, st, f.sigma);
   o.one_wall = one_wall;
+  o.misalignment = f.top_step;
   const char* why = why_not_v(o, st, f, one_wall ? 0 : kMinWall);
   if (why) {
     o.why = why;
@@ -560,12 +573,12 @@ bool unseen_rim(const Eigen::Vector3d& q, const ProfileFit& f, bool left_missing
 }
 
 // `one`'s opening from the unseen rim at u = `edge` to the seen wall's rim, and its root where
-// the top normal through the opening's centre meets the seen wall (running `up` to its rim).
-// False when the two are parallel or the root falls outside the opening.
-bool symmetric_root(const Eigen::Vector2d& seen_edge, const Eigen::Vector2d& up, double edge,
-                    bool left_missing, VModel& one) {
+// the top normal through u = `uc` (the opening's centre for a symmetric V, just inside the
+// unseen rim for a square side) meets the seen wall (running `up` to its rim). False when the
+// two are parallel or the root falls outside the opening.
+bool root_below(const Eigen::Vector2d& seen_edge, const Eigen::Vector2d& up, double edge, double uc,
+                bool left_missing, VModel& one) {
   const Eigen::Vector3d& q = one.q;
-  const double uc = 0.5 * (edge + seen_edge.x());
   const Eigen::Vector2d centre(uc, top_at(q, uc));
   const Eigen::Vector2d axis = -Eigen::Vector2d(-(q[1] + 2 * q[2] * uc), 1).normalized();
   Eigen::Matrix2d M;
@@ -579,14 +592,29 @@ bool symmetric_root(const Eigen::Vector2d& seen_edge, const Eigen::Vector2d& up,
   return one.u_left < one.root.x() && one.root.x() < one.u_right;
 }
 
-// 6. One wall seen, the other at a grazing angle (no or a few stray points, which the two-wall
-//    fit `m` then bends into a vertical or flat wall): the unseen wall's edge is where the top
-//    surface ends, half a sample spacing past the last top point, and the V is symmetric about
-//    the top normal through the opening's centre, so the root lies where that axis meets the
-//    seen wall. `two_wall` (m's profile) when that does not apply or fails to fit.
+// Whether the unseen wall, were it the mirror image of the seen one (running `up`) about the top
+// normal at u = `uc`, would face the sensor at less than kShownIncidenceDeg: then it would
+// have returned points, so it is not there and that side is square (a single bevel).
+bool mirror_would_show(const ProfileFit& f, const Eigen::Vector3d& q, double uc,
+                       const Eigen::Vector2d& up, bool left_missing) {
+  const Eigen::Vector2d n_top = Eigen::Vector2d(-(q[1] + 2 * q[2] * uc), 1).normalized();
+  const Eigen::Vector2d mirror = 2 * up.dot(n_top) * n_top - up;
+  // The mirror wall's face towards the groove: a quarter turn towards the seen wall.
+  const Eigen::Vector2d face = left_missing ? Eigen::Vector2d(mirror.y(), -mirror.x())
+                                            : Eigen::Vector2d(-mirror.y(), mirror.x());
+  return face.dot(f.view) > std::cos(deg_to_rad(kShownIncidenceDeg));
+}
+
+// 6. One wall seen, the other returned no or a few stray points (which the two-wall fit `m`
+//    then bends into a vertical or flat wall): the unseen wall's edge is where the top surface
+//    ends, half a sample spacing past the last top point. Hidden at a grazing angle, the V is
+//    symmetric about the top normal through the opening's centre, so the root lies where that
+//    axis meets the seen wall; hidden though its mirror image would face the sensor, that side
+//    is square (a single bevel seen along its square side) and the root is at its foot.
+//    `two_wall` (m's profile) when that does not apply or fails to fit.
 VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit& f) {
   auto seen = [](int points, double dip) {
-    return points >= 2 * kMinWall && dip >= 8 && dip <= 86;
+    return points >= 2 * kMinWall && dip >= 8 && dip <= kMaxDipDeg;
   };
   const bool left_seen = seen(two_wall.wall_left, two_wall.wall_left_deg);
   const bool right_seen = seen(two_wall.wall_right, two_wall.wall_right_deg);
@@ -596,22 +624,30 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
   double edge = 0;
   VModel one = m;
   if (!seen_wall(m, f, left_missing, seen_edge, up) ||
-      !unseen_rim(m.q, f, left_missing, seen_edge, edge) ||
-      !symmetric_root(seen_edge, up, edge, left_missing, one)) {
+      !unseen_rim(m.q, f, left_missing, seen_edge, edge)) {
+    return two_wall;
+  }
+  const double centre = 0.5 * (edge + seen_edge.x());
+  const bool square = mirror_would_show(f, m.q, centre, up, left_missing);
+  // A square side's foot, a hair inside its rim so that the model keeps its vertex order.
+  const double inside = 1e-3 * f.W * (left_missing ? 1 : -1);
+  if (!root_below(seen_edge, up, edge, square ? edge + inside : centre, left_missing, one)) {
     return two_wall;
   }
   VProfile alt = judge_v(one, true, f);
+  alt.square_side = square;
   if (!alt.ok) alt.why = "one wall: " + alt.why;
   return alt;
 }
 
 }  // namespace
 
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window,
-                       bool symmetric) {
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, bool symmetric,
+                       const Eigen::Vector2d& view) {
   VProfile out;
   ProfileFit f;
   f.W = half_window;
+  f.view = view.normalized();
   f.pts.reserve(all.size());
   for (const auto& p : all) {
     if (std::abs(p.x()) <= f.W && p.allFinite()) f.pts.push_back(p);

@@ -21,23 +21,48 @@ using nlohmann::json;
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// The fitted cross-section at every station of a seam (docs/method-robust.md, "Score"):
+// arc length and root (m, the cloud's frame), opening width, depth, included angle, high-low,
+// and how the station was fitted.
+json stations_json(const SeamCandidate& seam) {
+  auto num = finite_or_null;
+  json out = json::array();
+  for (const GrooveSection& s : seam.sections) {
+    const char* fit = s.ok ? (s.one_wall ? "one_wall" : "v") : s.inferred ? "inferred" : "none";
+    out.push_back(
+        {{"s_m", num(s.s)},
+         {"root_m", {num(s.root.x()), num(s.root.y()), num(s.root.z())}},
+         {"opening_m", num(s.width)},
+         {"depth_m", num(s.depth)},
+         {"included_angle_deg", s.ok ? num(s.opening_deg) : json(nullptr)},
+         {"misalignment_m", s.ok && !s.one_wall ? num(std::abs(s.misalignment)) : json(nullptr)},
+         {"fit", fit}});
+  }
+  return out;
+}
+
 json seam_json(const SeamCandidate& s, std::size_t rank, const json& file) {
   auto num = finite_or_null;
-  return {{"rank", rank},
-          {"accepted", s.accepted},
-          {"reason", s.reason},
-          {"score", num(s.score)},
-          {"length_m", num(s.length)},
-          {"closed", s.closed},
-          {"corners", s.curve.corners.size()},
-          {"sections", s.sections.size()},
-          {"ok_fraction", num(s.ok_fraction)},
-          {"fit_quality", num(s.fit_quality)},
-          {"consistency", num(s.consistency)},
-          {"width_m", num(s.width)},
-          {"depth_m", num(s.depth)},
-          {"opening_deg", num(s.opening_deg)},
-          {"file", file}};
+  json j = {{"rank", rank},
+            {"accepted", s.accepted},
+            {"reason", s.reason},
+            {"score", num(s.score)},
+            {"length_m", num(s.length)},
+            {"closed", s.closed},
+            {"corners", s.curve.corners.size()},
+            {"sections", s.sections.size()},
+            {"ok_fraction", num(s.ok_fraction)},
+            {"fit_quality", num(s.fit_quality)},
+            {"consistency", num(s.consistency)},
+            {"width_m", num(s.width)},
+            {"depth_m", num(s.depth)},
+            {"opening_deg", num(s.opening_deg)},
+            {"joint", s.joint},
+            {"misalignment_m", num(s.misalignment)},
+            {"scale_m", num(s.scale)},
+            {"file", file}};
+  if (!file.is_null()) j["stations"] = stations_json(s);
+  return j;
 }
 
 // report.json "robust": the candidate threshold and every candidate seam with its score
@@ -54,12 +79,24 @@ json robust_report(const RobustDetection& rd, int max_seams) {
     }
     seams.push_back(seam_json(s, k, file));
   }
+  json scales = json::array();
+  for (const ScaleSearchSummary& sc : rd.scales) {
+    scales.push_back({{"scale_m", sc.scale},
+                      {"cell_m", sc.cell},
+                      {"concavity_threshold_m", sc.threshold},
+                      {"candidate_voxels", sc.candidates},
+                      {"crease_nodes", sc.nodes},
+                      {"confirmed_nodes", sc.confirmed_nodes},
+                      {"seams", sc.seams},
+                      {"kept", sc.kept}});
+  }
   return {{"concavity_threshold_m", rd.threshold},
           {"concavity_sigma_m", rd.noise_sigma},
           {"candidate_voxels", rd.candidates},
           {"crease_nodes", rd.nodes},
           {"confirmed_nodes", rd.confirmed_nodes},
           {"score", "length_mm * ok_fraction * fit_quality * consistency"},
+          {"scales", scales},
           {"seams", seams}};
 }
 
