@@ -38,10 +38,10 @@ bool grazing(const Context& ctx, const Eigen::Vector3d& p, const Eigen::Vector3d
 
 /// Fits the section at `origin` (m) across `tangent` laid into the surface, the profile taken
 /// within `slab` (m) along it and oriented by `normal`; `scratch` holds the ball's points.
-/// `symmetric` as in fit_v_profile.
+/// `mode` as in fit_v_profile.
 GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
-                         std::vector<std::uint32_t>& scratch, bool symmetric = false);
+                         std::vector<std::uint32_t>& scratch, VFit mode = {});
 
 /// Traces one seam along its ordered node roots (m) with their surface normals: sections
 /// fitted at stations along it, twice, smoothed along it, and its ends extended and trimmed.
@@ -62,8 +62,8 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
 void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link);
 
 /// The seams of every scale's search, ranked best first, without the ones that repeat a better
-/// seam: a seam is dropped when 30 % or more of its root line runs within half the wider of
-/// the two grooves (at least 3 mm) of a seam kept before it. Order kept.
+/// seam: a seam is dropped when half or more of its root line runs within the groove (half its
+/// width, at least 3 mm) of a seam kept before it. Order kept.
 std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked);
 
 }  // namespace groovetrace::robust_detail

@@ -131,21 +131,38 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
   search.summary.seams = search.seams.size();
 }
 
-// A seam's score as a reading of its groove at the scale it was found at: the window holds a
-// groove up to kWidthPerScale times the scale wide with top surface to spare; a wider one's
-// top was fitted on its rims or walls (the tool axis tilts with them, a wide joint reads as
-// a narrower V), so its score counts the less the more it overfills the window.
+// A seam fits the scale it was found at when the window holds its groove with top surface to
+// spare on both sides (up to kWidthPerScale times the scale wide). Found at a smaller scale,
+// its top was fitted on its rims or walls: the tool axis tilts with them, and a wide joint
+// reads as a narrower V.
+bool fits_scale(const SeamCandidate& seam) { return seam.width <= kWidthPerScale * seam.scale; }
+
+// The score as a reading of the groove at its scale: discounted the more the groove
+// overfills the window.
 double scale_fit_score(const SeamCandidate& seam) {
   const double over = seam.width / (kWidthPerScale * seam.scale);
   return over > 1 ? seam.score / (over * over) : seam.score;
 }
 
-// Accepted seams first, each group by scale_fit_score, best first.
-void rank_seams(std::vector<SeamCandidate>& seams) {
-  std::stable_sort(seams.begin(), seams.end(), [](const SeamCandidate& a, const SeamCandidate& b) {
+// The order in which one groove's readings at several scales are kept: accepted first, then
+// those that fit their scale, the finest of those first (its crease nodes and stations are
+// the densest), then the best scale_fit_score.
+bool keep_before(const SeamCandidate& a, const SeamCandidate& b) {
+  if (a.accepted != b.accepted) return a.accepted;
+  if (fits_scale(a) != fits_scale(b)) return fits_scale(a);
+  if (fits_scale(a) && a.scale != b.scale) return a.scale < b.scale;
+  return scale_fit_score(a) > scale_fit_score(b);
+}
+
+// The grooves of every scale, each at one scale: accepted first, then by scale_fit_score.
+std::vector<SeamCandidate> one_scale_per_groove(std::vector<SeamCandidate> all) {
+  std::stable_sort(all.begin(), all.end(), keep_before);
+  std::vector<SeamCandidate> kept = robust_detail::drop_duplicate_scales(std::move(all));
+  std::stable_sort(kept.begin(), kept.end(), [](const SeamCandidate& a, const SeamCandidate& b) {
     if (a.accepted != b.accepted) return a.accepted;
     return scale_fit_score(a) > scale_fit_score(b);
   });
+  return kept;
 }
 
 }  // namespace
@@ -183,8 +200,7 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
     det.scales.push_back(search.summary);
     for (SeamCandidate& seam : search.seams) all.push_back(std::move(seam));
   }
-  rank_seams(all);
-  det.seams = robust_detail::drop_duplicate_scales(std::move(all));
+  det.seams = one_scale_per_groove(std::move(all));
   for (ScaleSearchSummary& sum : det.scales) {
     for (const SeamCandidate& seam : det.seams) sum.kept += (seam.scale == sum.scale);
   }

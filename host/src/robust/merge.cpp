@@ -197,8 +197,8 @@ std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> rank
   for (SeamCandidate& seam : ranked) {
     bool repeats = false;
     for (const SeamCandidate& k : kept) {
-      const double reach = std::max(0.003, 0.5 * std::max(seam.width, k.width));
-      repeats = repeats || share_near(seam, k, reach) >= 0.3;
+      const double reach = std::max(0.003, 0.5 * k.width);
+      repeats = repeats || share_near(seam, k, reach) >= 0.5;
     }
     if (!repeats) kept.push_back(std::move(seam));
   }

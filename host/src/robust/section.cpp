@@ -123,7 +123,7 @@ void place_in_gap(const Profile& pr, const Eigen::Vector3d& origin, const Eigen:
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
                           const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
                           const Eigen::Vector3d& normal_hint, double slab, double half_window,
-                          bool symmetric) {
+                          VFit mode) {
   GrooveSection sec;
   const Profile pr = profile_of(cloud, candidates, origin, tangent, normal_hint, slab);
   if (!pr.ok) {
@@ -134,7 +134,7 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
   const Eigen::Vector3d to_sensor = cloud.viewpoint.cast<double>() - origin;
   const Eigen::Vector2d view(to_sensor.dot(pr.a), to_sensor.dot(pr.n));
   const VProfile f =
-      fit_v_profile(thinned(pr), half_window, symmetric,
+      fit_v_profile(thinned(pr), half_window, mode,
                     view.norm() > 0 ? Eigen::Vector2d(view.normalized()) : Eigen::Vector2d(0, 1));
   auto to3 = [&](const Eigen::Vector2d& p) { return pr.at(origin, p.x(), p.y()); };
   sec.tangent = pr.t;

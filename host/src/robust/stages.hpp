@@ -78,6 +78,18 @@ struct VProfile {
   double misalignment = 0.0;
 };
 
+/// What a seam's first pass knows about its groove, for the second pass's fits.
+struct VFit {
+  /// The walls dip alike: after the free fit, the walls are refitted with equal dips about
+  /// the top normal through the root, so a poorly sampled wall (a grazing view puts two image
+  /// rows on it) takes its slope from the other and only its offset from its own points.
+  bool symmetric = false;
+  /// The plates are set high-low: the two top sides are fitted with one slope and each its own
+  /// height (their step held at what lines fitted to each side alone give), so the step does
+  /// not tilt the top normal or move the edges. Not with `symmetric`.
+  bool stepped = false;
+};
+
 /// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
 /// quadratic (so pipes work), then the whole V - root, both edges, the top's offset and slope -
 /// by a Tukey-weighted Gauss-Newton fit to the points' orthogonal distances, started from the
@@ -85,23 +97,19 @@ struct VProfile {
 /// the profile is a V: both walls inclined into the material, both top sides present, depth
 /// above the noise. Rims and root, which sensors round off, do not enter the fit. With one wall
 /// seen and the other at a grazing angle, the V is taken symmetric (VProfile::one_wall).
-/// `symmetric`: the V is known to be symmetric (the seam's walls dip alike): after the free
-/// fit, the walls are refitted with equal dips about the top normal through the root, so a
-/// poorly sampled wall (a grazing view puts two image rows on it) takes its slope from the
-/// other and only its offset from its own points.
-/// `view`: unit direction towards the sensor in profile coordinates (it tells a wall hidden at a
-/// grazing angle from a square side that cannot be seen).
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window,
-                       bool symmetric = false, const Eigen::Vector2d& view = Eigen::Vector2d(0, 1));
+/// `mode`: see VFit. `view`: unit direction towards the sensor in profile coordinates (it tells a
+/// wall hidden at a grazing angle from a square side that cannot be seen).
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window, VFit mode = {},
+                       const Eigen::Vector2d& view = Eigen::Vector2d(0, 1));
 
 /// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
 /// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)
 /// of origin across it. `normal_hint` orients the profile (towards the viewpoint).
-/// `symmetric` as in fit_v_profile.
+/// `mode` as in fit_v_profile; the view towards the sensor comes from cloud.viewpoint.
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
                           const Eigen::Vector3d& origin, const Eigen::Vector3d& tangent,
                           const Eigen::Vector3d& normal_hint, double slab, double half_window,
-                          bool symmetric = false);
+                          VFit mode = {});
 
 /// Where the walls return nothing (seen at a grazing angle) a groove still shows as a gap in
 /// the top surface. Fits that instead of a V: both sides carry top surface, the gap nearest

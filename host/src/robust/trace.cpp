@@ -15,12 +15,12 @@ namespace groovetrace::robust_detail {
 
 GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
-                         std::vector<std::uint32_t>& scratch, bool symmetric) {
+                         std::vector<std::uint32_t>& scratch, VFit mode) {
   const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
   // The ball holds the window across, the slab along and the groove's depth below.
   const double radius = 1.3 * ctx.half_window + slab;
   ctx.bins.within(ctx.cloud, origin, radius, scratch);
-  return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window, symmetric);
+  return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window, mode);
 }
 
 namespace {
@@ -77,13 +77,13 @@ std::size_t nearest(const std::vector<Eigen::Vector3d>& points, const Eigen::Vec
   return best;
 }
 
-// Stations along `curve`, each fitted; normals from the nearest of `hint_points`. `symmetric`:
-// fit symmetric V's (see fit_v_profile). Where the V failed, a gap of the seam's width seen at a
+// Stations along `curve`, each fitted; normals from the nearest of `hint_points`. `mode` as in
+// fit_v_profile. Where the V failed, a gap of the seam's width seen at a
 // slant stands in (the same test the tracking uses, with this pass's median width and depth).
 std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& curve,
                                         const std::vector<Eigen::Vector3d>& hint_points,
                                         const std::vector<Eigen::Vector3d>& hint_normals,
-                                        bool symmetric) {
+                                        VFit mode) {
   const std::size_t m = curve.points.size();
   std::vector<GrooveSection> secs(m);
   const std::int64_t count = static_cast<std::int64_t>(m);
@@ -94,7 +94,7 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
     for (std::int64_t k = 0; k < count; ++k) {
       const std::size_t best = nearest(hint_points, curve.points[k]);
       secs[k] = section_at(ctx, curve.points[k], curve.tangents[k], hint_normals[best],
-                           ctx.params.slab, scratch, symmetric);
+                           ctx.params.slab, scratch, mode);
       secs[k].s = curve.s[k];
     }
   }
@@ -294,6 +294,34 @@ bool symmetric_seam(const std::vector<GrooveSection>& secs) {
   return std::abs(seam_asymmetry(secs)) < deg_to_rad(kSymmetricDeg);  // false for NaN
 }
 
+// A high-low below this share of the groove's depth is not modelled, nor one that is not the
+// same all along the seam: a D415's noise and undulation alone make the two top sides of a
+// level joint differ by up to a millimetre at 640x480, this way and that, and fitting a step
+// to that would take the top's slope from each side's short run alone.
+constexpr double kStepShare = 0.1;
+
+// Plates set high-low: the two-wall sections' signed step between the top sides (right minus
+// left, the same sides all along a seam) has a median clear of the groove's size and of its
+// own spread along the seam.
+bool stepped_seam(const std::vector<GrooveSection>& secs) {
+  std::vector<double> step, depth;
+  for (const auto& s : secs) {
+    if (!s.ok || s.one_wall) continue;
+    step.push_back(s.misalignment);
+    depth.push_back(s.depth);
+  }
+  if (step.size() < 3) return false;
+  const double median = upper_median(step);
+  return std::abs(median) > std::max(kStepShare * upper_median(depth), mad_sigma(step, median));
+}
+
+VFit seam_fit_mode(const std::vector<GrooveSection>& secs) {
+  VFit mode;
+  mode.stepped = stepped_seam(secs);
+  mode.symmetric = !mode.stepped && symmetric_seam(secs);
+  return mode;
+}
+
 void align_bisectors(std::vector<GrooveSection>& secs) {
   double turn = seam_asymmetry(secs);
   if (std::isnan(turn)) return;
@@ -383,15 +411,16 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
   // footprint on it stretches to 2-4 mm, and its slope from the two or three image rows it
   // gets (one of them blurred into the root by stereo matching) comes out several degrees too
   // flat, which moves its rim out and the root towards the other wall by up to a millimetre.
-  bool symmetric = false;
+  // Plates set high-low are fitted with a step between the two tops the second time (VFit).
+  VFit mode;
   for (int pass = 0; pass < 2; ++pass) {
     // Sampled finely, then at stations anchored to the frame (robust/stations.hpp).
     const SeamCurve curve = anchored_stations(
         smooth_curve(ordered, closed, p.smooth, 0.25 * p.station, normals), p.station);
     if (curve.points.size() < 2) break;
-    std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, symmetric);
+    std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, mode);
     reject_inconsistent(raw);
-    if (pass == 0) symmetric = symmetric_seam(raw);
+    if (pass == 0) mode = seam_fit_mode(raw);
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);

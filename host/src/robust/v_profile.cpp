@@ -343,9 +343,9 @@ constexpr int kMinWall = 4;
 // measured with noise); beyond, it overhangs. A step down to a table is told by its two top
 // sides at different heights, not by its dip.
 constexpr double kMaxDipDeg = 95.0;
-// The two top sides may differ in height by this share of the depth (plates set high-low);
-// more is a step or a channel between two parts (a bar lying beside a plate).
-constexpr double kMaxStepShare = 0.3;
+// The two top sides may differ in height by this share of the depth (plates set high-low) or
+// by twice the noise band tau; more is a step down to a table.
+constexpr double kMaxStepShare = 0.5;
 // A wall facing the sensor at less than this incidence returns points (the D415 drops out from
 // about 75 deg).
 constexpr double kShownIncidenceDeg = 65.0;
@@ -361,8 +361,25 @@ struct ProfileFit {
   double scale = 0;                    // Tukey scale of the V fit
   double vertex_zone = 0;              // points this near a vertex stay out of the fits
   double top_step = 0;                 // right top side's line minus the left's at u = 0
+  bool stepped = false;                // fit the tops with a step (VFit::stepped)
+  double step = 0;                     // the step held in the fit: top_step, or 0
   Eigen::Vector2d view{0, 1};          // unit, towards the sensor
+  // Height of the top `q` at u on the side of u = 0 where u lies.
+  double top(const Eigen::Vector3d& q, double u) const { return top_at(q, u) + (u > 0 ? step : 0); }
 };
+
+// Each side's top on its own, as a line from the outer half: a real groove's two top sides
+// continue each other (curved or not, their lines meet above the centre at one height); a
+// step down to a table fitted by one tilted line does not, and plates set high-low differ by
+// their misalignment. The right line's height minus the left's at u = 0 (m); 0 without three
+// points on each side.
+double top_step(const std::vector<Eigen::Vector2d>& outer) {
+  std::vector<Eigen::Vector2d> lo, hi;
+  for (const auto& p : outer) (p.x() < 0 ? lo : hi).push_back(p);
+  if (lo.size() < 3 || hi.size() < 3) return 0;
+  const Eigen::Vector3d ql = fit_poly(lo, 1).first, qr = fit_poly(hi, 1).first;
+  return qr[0] - ql[0];
+}
 
 // 1. The top surface `q` from the outer half of the window. A quadratic needs both sides; its
 //    curvature is bounded (radius >= W) so that it cannot bend into the groove. False without
@@ -376,8 +393,12 @@ bool fit_top(ProfileFit& f, Eigen::Vector3d& q) {
     }
   }
   if (n_left < 3 && n_right < 3) return false;
-  std::pair<Eigen::Vector3d, double> top = fit_poly(f.outer, n_left >= 3 && n_right >= 3 ? 2 : 1);
-  if (std::abs(top.first[2]) > 0.5 / f.W) top = fit_poly(f.outer, 1);
+  f.top_step = top_step(f.outer);
+  f.step = f.stepped ? f.top_step : 0.0;
+  std::vector<Eigen::Vector2d> level = f.outer;  // the right side lowered by the step
+  for (auto& p : level) p.y() -= f.top(Eigen::Vector3d::Zero(), p.x());
+  std::pair<Eigen::Vector3d, double> top = fit_poly(level, n_left >= 3 && n_right >= 3 ? 2 : 1);
+  if (std::abs(top.first[2]) > 0.5 / f.W) top = fit_poly(level, 1);
   q = top.first;
   f.sigma = top.second;
   // Points within tau of the top are top; tau covers the sensor noise with a floor for
@@ -393,7 +414,7 @@ std::vector<Eigen::Vector2d> groove_run(const ProfileFit& f, const Eigen::Vector
                                         std::string& why) {
   std::vector<Eigen::Vector2d> below;
   for (const auto& p : f.pts) {
-    if (p.y() - top_at(q, p.x()) < -f.tau) below.push_back(p);
+    if (p.y() - f.top(q, p.x()) < -f.tau) below.push_back(p);
   }
   if (below.size() < 6) {
     why = "nothing below the top surface";
@@ -410,7 +431,7 @@ std::vector<Eigen::Vector2d> groove_run(const ProfileFit& f, const Eigen::Vector
     double mass = 0;
     bool central = false;
     for (std::size_t k = lo; k < hi; ++k) {
-      mass += top_at(q, below[k].x()) - below[k].y();
+      mass += f.top(q, below[k].x()) - below[k].y();
       central = central || std::abs(below[k].x()) <= 0.5 * f.W;
     }
     if (central && mass > best_mass) {
@@ -429,9 +450,11 @@ std::vector<Eigen::Vector2d> groove_run(const ProfileFit& f, const Eigen::Vector
 
 // 3. The initial V from the groove's run (sorted by u) under the top `q`: root at its deepest
 //    points, edges at its ends.
-VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q, double W) {
+VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q,
+                 const ProfileFit& f) {
+  const double W = f.W;
   std::vector<double> depths, deep_u;
-  for (const auto& p : groove) depths.push_back(top_at(q, p.x()) - p.y());
+  for (const auto& p : groove) depths.push_back(f.top(q, p.x()) - p.y());
   std::vector<double> sorted_depths = depths;
   std::sort(sorted_depths.begin(), sorted_depths.end());
   const double d90 = sorted_depths[(sorted_depths.size() * 9) / 10];
@@ -441,23 +464,11 @@ VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector
   const double u0 = upper_median(deep_u);
   VModel m;
   m.q = q;
-  m.root = Eigen::Vector2d(u0, top_at(q, u0) - d90);
+  m.step = f.step;
+  m.root = Eigen::Vector2d(u0, f.top(q, u0) - d90);
   m.u_left = std::min(groove.front().x(), u0 - 0.1 * W);
   m.u_right = std::max(groove.back().x(), u0 + 0.1 * W);
   return m;
-}
-
-// Each side's top on its own, as a line from the outer half: a real groove's two top sides
-// continue each other (curved or not, their lines meet above the centre at one height); a
-// step down to a table fitted by one tilted line does not, and plates set high-low differ by
-// their misalignment. The right line's height minus the left's at u = 0 (m); 0 without three
-// points on each side.
-double top_step(const std::vector<Eigen::Vector2d>& outer) {
-  std::vector<Eigen::Vector2d> lo, hi;
-  for (const auto& p : outer) (p.x() < 0 ? lo : hi).push_back(p);
-  if (lo.size() < 3 || hi.size() < 3) return 0;
-  const Eigen::Vector3d ql = fit_poly(lo, 1).first, qr = fit_poly(hi, 1).first;
-  return qr[0] - ql[0];
 }
 
 // The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
@@ -476,7 +487,8 @@ VProfile describe_v(const VModel& v, const PieceStats& st, double fallback_noise
   o.rms = st.wall_rms;
   o.noise = st.top_sigma > 0 ? st.top_sigma : fallback_noise;
   o.width = (er - el).norm();
-  o.depth = top_at(v.q, v.root.x()) - v.root.y();
+  // Below the lower top (high-low plates: the depth of the joint's lower side).
+  o.depth = std::min(v.top(v.root.x(), false), v.top(v.root.x(), true)) - v.root.y();
   const Eigen::Vector2d to_root_l = (v.root - el).normalized();
   const Eigen::Vector2d to_root_r = (v.root - er).normalized();
   const Eigen::Vector2d tl = Eigen::Vector2d(1, v.q[1] + 2 * v.q[2] * el.x()).normalized();
@@ -527,6 +539,13 @@ VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   return o;
 }
 
+// The top of `m` on its right (or left) side as one curve's coefficients.
+Eigen::Vector3d side_top(const VModel& m, bool right) {
+  Eigen::Vector3d q = m.q;
+  if (right) q[0] += m.step;
+  return q;
+}
+
 // The wall of the failed V `m` on the seen side, refitted alone (the failed fit's root may have
 // been dragged by strays): `edge` where it meets the top, `up` the unit direction up the wall
 // towards it. False with too few wall points or no crossing.
@@ -541,7 +560,7 @@ bool seen_wall(const VModel& m, const ProfileFit& f, bool left_missing, Eigen::V
   if (wall_pts.size() < static_cast<std::size_t>(2 * kMinWall)) return false;
   const auto [wc, wd] = fit_line(wall_pts, f.scale);
   up = (left_missing ? wd.x() > 0 : wd.x() < 0) ? wd : Eigen::Vector2d(-wd);
-  return meet_top(wc, up, m.q, edge);
+  return meet_top(wc, up, side_top(m, left_missing), edge);
 }
 
 // The unseen wall's rim, u (m): the top on that side ends there (its innermost point, plus half
@@ -624,7 +643,7 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
   double edge = 0;
   VModel one = m;
   if (!seen_wall(m, f, left_missing, seen_edge, up) ||
-      !unseen_rim(m.q, f, left_missing, seen_edge, edge)) {
+      !unseen_rim(side_top(m, !left_missing), f, left_missing, seen_edge, edge)) {
     return two_wall;
   }
   const double centre = 0.5 * (edge + seen_edge.x());
@@ -642,11 +661,12 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
 
 }  // namespace
 
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, bool symmetric,
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
                        const Eigen::Vector2d& view) {
   VProfile out;
   ProfileFit f;
   f.W = half_window;
+  f.stepped = mode.stepped;
   f.view = view.normalized();
   f.pts.reserve(all.size());
   for (const auto& p : all) {
@@ -665,7 +685,7 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   out.noise = f.sigma;
   const std::vector<Eigen::Vector2d> groove = groove_run(f, q, out.why);
   if (groove.empty()) return out;
-  VModel m = initial_v(groove, q, f.W);
+  VModel m = initial_v(groove, q, f);
 
   // 4. Joint robust fit of the whole V (root, both edges, the top's offset and slope) to the
   //    orthogonal distances, by Gauss-Newton with Tukey weights. Points near the three
@@ -676,11 +696,10 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
     out.why = "V fit did not converge";
     return out;
   }
-  if (symmetric) {
+  if (mode.symmetric && !mode.stepped) {
     VModel sym = m;
     if (refine_v(f.pts, sym, f.scale, f.vertex_zone, 0.1 * f.W, true)) m = sym;
   }
-  f.top_step = top_step(f.outer);
   const VProfile two_wall = judge_v(m, false, f);
   if (two_wall.ok) return two_wall;
   return one_wall_v(m, two_wall, f);

@@ -75,11 +75,11 @@ std::pair<int, double> nearest_piece(const Eigen::Vector2d& p, const VModel& m, 
     const double u = p.x();
     if (top_inside(left)) {
       const double slope = m.q[1] + 2 * m.q[2] * u;
-      return (p.y() - top_at(m.q, u)) / std::sqrt(1 + slope * slope);
+      return (p.y() - m.top(u, !left)) / std::sqrt(1 + slope * slope);
     }
     const Eigen::Vector2d e = left ? el : er;
     const double d = (p - e).norm();
-    return p.y() >= top_at(m.q, u) ? d : -d;
+    return p.y() >= m.top(u, !left) ? d : -d;
   };
   const double tl = top_dist(true), tr = top_dist(false);
   int best = 0;
@@ -103,7 +103,7 @@ std::pair<int, double> nearest_piece(const Eigen::Vector2d& p, const VModel& m, 
       const double slope = m.q[1] + 2 * m.q[2] * u;
       const double S = std::sqrt(1 + slope * slope);
       (*grad)[kQ0] = -1 / S;
-      (*grad)[kQ1] = -u / S - (p.y() - top_at(m.q, u)) * slope / (S * S * S);
+      (*grad)[kQ1] = -u / S - (p.y() - m.top(u, best == 3)) * slope / (S * S * S);
     } else {
       const Eigen::Vector2d e = best == 0 ? el : er;
       const double d = (p - e).norm();

@@ -18,14 +18,18 @@ inline double top_at(const Eigen::Vector3d& q, double u) { return q[0] + q[1] * 
 /// the robust sigma of the final fit's residuals (m). Defined in v_profile.cpp.
 std::pair<Eigen::Vector3d, double> fit_poly(const std::vector<Eigen::Vector2d>& pts, int degree);
 
-/// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held in fits), a root vertex, and the
-/// two edges where the walls leave the top at u_left < root.u < u_right (m).
+/// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held in fits) on the left, the same
+/// raised by `step` on the right (plates set high-low; held in fits), a root vertex, and the
+/// two edges where the walls leave the tops at u_left < root.u < u_right (m).
 struct VModel {
   Eigen::Vector3d q{0, 0, 0};
+  double step = 0;
   Eigen::Vector2d root{0, 0};
   double u_left = 0, u_right = 0;
-  Eigen::Vector2d edge_left() const { return {u_left, top_at(q, u_left)}; }
-  Eigen::Vector2d edge_right() const { return {u_right, top_at(q, u_right)}; }
+  /// Height of the left (right = false) or right top at u (m).
+  double top(double u, bool right) const { return top_at(q, u) + (right ? step : 0.0); }
+  Eigen::Vector2d edge_left() const { return {u_left, top(u_left, false)}; }
+  Eigen::Vector2d edge_right() const { return {u_right, top(u_right, true)}; }
 };
 
 /// The fitted parameters, in this order: root u, root v, u_left, u_right, q0, q1.
