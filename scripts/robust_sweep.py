@@ -792,6 +792,7 @@ def fill_joint(scan, filled, seed):
     with open(scan[:-4] + ".truth.json") as f:
         truth = json.load(f)
     cam, T = truth["camera"], truth["T_workpiece_camera"]
+    T = [v for row in T for v in row] if isinstance(T[0], list) else T  # 4x4, row-major
     sensor, unit = truth["params"]["sensor"], truth["params"]["depth_unit_m"]
     top = truth["groove"]["thickness_m"]
     w = int(header["WIDTH"][0])
@@ -807,10 +808,10 @@ def fill_joint(scan, filled, seed):
         den = sum(T[8 + k] * ray[k] for k in range(3))
         z = (top - T[11]) / den if den else -1.0
         disparity = cam["fx"] * cam["baseline_m"] / z if z > 0 else 0.0
-        if z < sensor["min_z"] or u < disparity:
+        if z < sensor["min_z_m"] or u < disparity:
             out.append([float("nan")] * 3)
             continue
-        z = cam["fx"] * cam["baseline_m"] / (disparity + rng.gauss(0.0, sensor["subpixel"]))
+        z = cam["fx"] * cam["baseline_m"] / (disparity + rng.gauss(0.0, sensor["subpixel_px"]))
         z = round(z / unit) * unit
         out.append([ray[0] * z, ray[1] * z, z])
     write_pcd_ascii(filled, ["x", "y", "z"], out, w, int(header["HEIGHT"][0]))
@@ -948,15 +949,16 @@ def family_value_rows(records):
          "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|"]
     for fam, rs in joint_families_in(records):
         c = family_checks(rs)
-        cell = lambda k, d=2: f"{fmt(c[k][0], d)} ({fmt(c[k][1], d)}-{fmt(c[k][2], d)})"
+        cell = lambda k, d=2: ("-" if math.isnan(c[k][1]) else
+                               f"{fmt(c[k][0], d)} ({fmt(c[k][1], d)}-{fmt(c[k][2], d)})")
         found = sorted({str(scan_values(r)["joint_found"]) for r in rs if r["rc"] == 0})
-        scales = sorted({fmt((r.get("scale_m") or float("nan")) * 1e3, 0) for r in rs
-                         if r["rc"] == 0})
+        joint = f"{'/'.join(found)} ({c['joint'][0]}/{c['joint'][1]})" if found else "-"
+        scales = [fmt(x * 1e3, 0) for x in sorted({r["scale_m"] for r in rs
+                                                   if r["rc"] == 0 and r.get("scale_m")})]
         L.append(f"| {fam} | {rs[0].get('joint_expected', '-')} | {len(rs)} | "
                  f"{sum(1 for r in rs if scan_values(r)['found'])} | {cell('iou')} | "
                  f"{cell('lateral_mm')} | {cell('depth_mm')} | {cell('tool_deg')} | "
-                 f"{cell('coverage', 1)} | {'/'.join(found) or '-'} ({c['joint'][0]}/"
-                 f"{c['joint'][1]}) | {', '.join(scales) or '-'} |")
+                 f"{cell('coverage', 1)} | {joint} | {', '.join(scales) or '-'} |")
     return L
 
 
