@@ -976,7 +976,8 @@ def family_target_rows(records):
             cells.append(f"{'pass' if ok else '**FAIL**'} {meets}/{len(rs)}")
             if not ok:
                 label, unit, sense = TARGET_LABELS[key]
-                missed.append(f"{label} {fmt(avg)} {unit} (target {sense} {limit:g})")
+                value = "- (no scan found the joint)" if math.isnan(avg) else f"{fmt(avg)} {unit}"
+                missed.append(f"{label} {value} (target {sense} {limit:g})")
         m, n, ok = c["joint"]
         cells.append("-" if n == 0 else f"{'pass' if ok else '**FAIL**'} {m}/{n}")
         if n and not ok:
@@ -1025,7 +1026,8 @@ def no_joint_rows(records):
             f = r.get("found") or {}
             length, width = (f.get("length_m") or 0) * 1e3, (f.get("width_m") or 0) * 1e3
             what = (f"**FAIL**: found a {f.get('joint')} seam, {fmt(length, 0)} mm long, "
-                    f"{fmt(width, 1)} mm wide")
+                    f"{fmt(width, 1)} mm wide, {fmt((f.get('depth_m') or 0) * 1e3, 1)} mm deep "
+                    f"(scale {fmt((f.get('scale_m') or 0) * 1e3, 0)} mm)")
         else:
             what = "**FAIL**: " + " ".join(r.get("stderr", []))
         L.append(f"| {r['scan']}: {r['what']} | {r['rc']} | {what} |")
@@ -1054,6 +1056,8 @@ def joint_header(args, records):
         "target when its mean over its scans meets it; k/n = scans meeting it on their own. A "
         "scan that exits 4 (no groove found) although it has a joint counts as found = no, IoU "
         "0 % and coverage 0 %; its lateral, depth and tool axis are left out (no trajectory). "
+        "found = exit 0: the exported seam may still be another one than the joint (IoU near 0, "
+        "errors of centimetres: see every scan). "
         "The detector reports only `V` or `bevel`, so fillet and lap cannot match.", ""]
 
 
