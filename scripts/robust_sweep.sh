@@ -3,8 +3,11 @@
 # 1280x720, distances 0.30-0.55 m, tilts -20..20 deg), the robust and the paper method on
 # each, `groovetrace eval`, trajectory checks (NaN, jumps, tool axis), unorganized and
 # robot-base-frame variants, a scan without a groove; writes docs/results-robust.md.
+# --set joints: issue 12's shop joints and conditions (about 65 scans in families, the robust
+# method, scenes without a joint) into their own section of --results; --set all: both.
 #
-#   scripts/robust_sweep.sh [--quick] [--bin build/groovetrace] [--out out/robust_sweep]
+#   scripts/robust_sweep.sh [--quick] [--only PATTERN] [--set shapes|joints|all]
+#       [--bin build/groovetrace] [--out out/robust_sweep]
 #       [--results docs/results-robust.md] [--methods robust,paper]
 #
 # The work is done by scripts/robust_sweep.py (Debian's /usr/bin/python3, standard library).
