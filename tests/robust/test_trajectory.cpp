@@ -96,6 +96,82 @@ TEST(RobustTrajectory, ClosedSeamReturnsToItsStart) {
   EXPECT_NEAR(t.waypoints.front().position.x(), -0.04, 1e-4);
 }
 
+// An L: 60 mm along +x, a 90 deg corner at the origin, 60 mm along +y; sections every 1.5 mm,
+// the bisector tilted 10 deg across the first leg. Tangent signs carry no meaning.
+SeamCandidate l_corner() {
+  SeamCandidate s;
+  const Eigen::Vector3d up(0, std::sin(10 * M_PI / 180), -std::cos(10 * M_PI / 180));
+  for (int k = -40; k <= 40; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    const double d = 0.0015 * std::abs(k);
+    g.root = k <= 0 ? Eigen::Vector3d(-d, 0, 0.4) : Eigen::Vector3d(0, d, 0.4);
+    g.tangent = Eigen::Vector3d(k <= 0 ? 1 : 0, k <= 0 ? 0 : 1, 0) * (k % 3 ? 1 : -1);
+    g.normal = g.bisector = k <= 0 ? up : Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  return s;
+}
+
+// Through a corner the torch turns over the blend length (orientation_blend), at no more than
+// 1.5 times 90 deg / blend per millimetre; without blending it turns within one step. The
+// positions do not change.
+TEST(RobustTrajectory, OrientationTurnsThroughACornerOverTheBlendLength) {
+  RobustParams p;
+  for (double blend : {0.01, 0.025, 0.05}) {
+    SCOPED_TRACE(blend);
+    p.orientation_blend = blend;
+    const Trajectory t = seam_trajectory(l_corner(), p);
+    const RotationRate r = max_rotation_rate(t);
+    EXPECT_LE(r.deg_per_mm, 1.5 * 90.0 / (1000 * blend));
+    EXPECT_NEAR(r.at_m, 0.06, 0.5 * blend);
+    // The whole turn still happens: tool x along each leg at the ends, z into the workpiece.
+    const Eigen::Matrix3d R0 = t.waypoints.front().orientation.toRotationMatrix();
+    const Eigen::Matrix3d R1 = t.waypoints.back().orientation.toRotationMatrix();
+    EXPECT_GT(R0.col(0).x(), 0.9999);
+    EXPECT_GT(R1.col(0).y(), 0.9999);
+    for (const Waypoint& w : t.waypoints) {
+      EXPECT_GT(w.orientation.toRotationMatrix().col(2).z(), 0.98);
+    }
+  }
+  p.orientation_blend = 0;
+  const Trajectory sharp = seam_trajectory(l_corner(), p);
+  EXPECT_GT(max_rotation_rate(sharp).deg_per_mm, 20.0);
+  p.orientation_blend = 0.025;
+  const Trajectory blended = seam_trajectory(l_corner(), p);
+  ASSERT_EQ(sharp.waypoints.size(), blended.waypoints.size());
+  for (std::size_t k = 0; k < sharp.waypoints.size(); ++k) {
+    EXPECT_EQ(sharp.waypoints[k].position, blended.waypoints[k].position) << k;
+  }
+}
+
+// A straight seam with a constant (tilted) bisector keeps its orientation when blended.
+TEST(RobustTrajectory, BlendingLeavesAStraightSeamsOrientation) {
+  SeamCandidate s;
+  const Eigen::Vector3d up = Eigen::Vector3d(0.1, 0.3, -1).normalized();
+  for (int k = 0; k <= 100; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(-0.075 + 0.0015 * k, 0.0, 0.4 + 0.0003 * k);
+    g.tangent = Eigen::Vector3d(1, 0, 0.2).normalized() * (k % 3 ? 1 : -1);
+    g.normal = g.bisector = up;
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  RobustParams p;
+  p.orientation_blend = 0;
+  const Trajectory a = seam_trajectory(s, p);
+  p.orientation_blend = 0.05;
+  const Trajectory b = seam_trajectory(s, p);
+  ASSERT_EQ(a.waypoints.size(), b.waypoints.size());
+  for (std::size_t k = 0; k < a.waypoints.size(); ++k) {
+    EXPECT_LT(a.waypoints[k].orientation.angularDistance(b.waypoints[k].orientation), 1e-9) << k;
+    EXPECT_EQ(a.waypoints[k].position, b.waypoints[k].position) << k;
+  }
+  EXPECT_LT(max_rotation_rate(b).deg_per_mm, 1e-6);
+}
+
 TEST(RobustTrajectory, TooShortSeamThrowsNoGroove) {
   SeamCandidate s;
   s.sections.resize(1);
