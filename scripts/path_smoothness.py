@@ -17,12 +17,16 @@ is read (trajectory.csv, trajectory_1.csv, ...). Per trajectory:
   "corner" where the path's heading turns by more than 30 deg between the chords 10 mm before
   and after, else "run".
 
-With --before, every number is printed as BEFORE -> AFTER, for the runs both trees have.
+With --before, every number is printed as BEFORE -> AFTER, for the runs both trees have, and
+a last table compares each run's accuracy (metrics.json of `groovetrace eval`: IoU, lateral and
+depth mean, tool-axis mean) and flags a run that lost more than 0.5 IoU points, 0.05 mm of
+lateral or depth mean error or 0.5 deg of tool-axis error (issue 12's rule).
 Standard library only; run with Debian's /usr/bin/python3.
 """
 
 import argparse
 import glob
+import json
 import math
 import os
 import sys
@@ -214,6 +218,44 @@ def tables(after, before):
     return "\n".join(L) + "\n"
 
 
+ACCURACY = (("iou_percent", "IoU %", 1.0, -0.5), ("lateral_mean_m", "lateral mean mm", 1e3, 0.05),
+            ("depth_mean_m", "depth mean mm", 1e3, 0.05),
+            ("tool_axis_mean_deg", "tool axis mean deg", 1.0, 0.5))
+
+
+def metrics(tree):
+    out = {}
+    for path in sorted(glob.glob(os.path.join(tree, "robust", "*", "metrics.json"))):
+        with open(path) as f:
+            m = json.load(f)
+        out[os.path.basename(os.path.dirname(path))] = {**m.get("detection", {}),
+                                                        **m.get("trajectory", {})}
+    return out
+
+
+def accuracy_table(after_tree, before_tree):
+    """Per run: each accuracy metric BEFORE -> AFTER, '!' where the rule is broken."""
+    a, b = metrics(after_tree), metrics(before_tree)
+    L = ["## Accuracy against --before (! = beyond the rule)", "",
+         "| run | " + " | ".join(c[1] for c in ACCURACY) + " |",
+         "|---|" + "---:|" * len(ACCURACY)]
+    worst = {c[0]: 0.0 for c in ACCURACY}
+    for run in sorted(set(a) & set(b)):
+        cells = []
+        for key, _, scale, limit in ACCURACY:
+            x, y = b[run].get(key), a[run].get(key)
+            if x is None or y is None:
+                cells.append("-")
+                continue
+            d = (y - x) * scale
+            bad = d < limit if limit < 0 else d > limit
+            worst[key] = min(worst[key], d) if limit < 0 else max(worst[key], d)
+            cells.append(f"{x * scale:.2f} -> {y * scale:.2f}" + (" !" if bad else ""))
+        L.append(f"| {run} | " + " | ".join(cells) + " |")
+    L += ["", "Worst change: " + ", ".join(f"{c[1]} {worst[c[0]]:+.3f}" for c in ACCURACY), ""]
+    return "\n".join(L)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out")
@@ -223,6 +265,8 @@ def main():
     after = measure(a.out)
     before = measure(a.before) if a.before else None
     text = tables(after, before)
+    if a.before:
+        text += "\n" + accuracy_table(a.out, a.before)
     if a.markdown:
         with open(a.markdown, "w") as f:
             f.write(text)
