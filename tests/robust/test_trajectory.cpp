@@ -172,6 +172,56 @@ TEST(RobustTrajectory, BlendingLeavesAStraightSeamsOrientation) {
   EXPECT_LT(max_rotation_rate(b).deg_per_mm, 1e-6);
 }
 
+// A flat straight seam whose roots wave up and down by +-0.5 mm (period 15 mm, a D415's
+// undulation) comes out within +-0.1 mm; the waves across the seam stay (the path follows the
+// sections across), and RobustParams::depth_smooth = 0 leaves the depth alone.
+TEST(RobustTrajectory, DepthIsSmoothedAlongAFlatSeam) {
+  SeamCandidate s;
+  for (int k = 0; k <= 200; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    const double x = -0.15 + 0.0015 * k, wave = 0.0005 * std::sin(2 * M_PI * x / 0.015);
+    g.root = Eigen::Vector3d(x, 0.2 * wave, 0.4 + wave);
+    g.tangent = Eigen::Vector3d(1, 0, 0);
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  RobustParams p;
+  double inner = 0, across = 0, raw = 0;
+  for (const Waypoint& w : seam_trajectory(s, p).waypoints) {
+    if (std::abs(w.position.x()) < 0.1) inner = std::max(inner, std::abs(w.position.z() - 0.4));
+    across = std::max(across, std::abs(w.position.y()));
+  }
+  p.depth_smooth = 0;
+  for (const Waypoint& w : seam_trajectory(s, p).waypoints) {
+    raw = std::max(raw, std::abs(w.position.z() - 0.4));
+  }
+  EXPECT_LT(inner, 0.0001);
+  EXPECT_GT(across, 0.00009);
+  EXPECT_GT(raw, 0.00045);
+}
+
+// A seam that curves in depth (half a ring of radius 50 mm round a pipe, the normal radial)
+// keeps its shape: the quadratic follows the curvature.
+TEST(RobustTrajectory, DepthSmoothingFollowsAPipe) {
+  SeamCandidate s;
+  for (int k = 0; k <= 100; ++k) {
+    const double a = M_PI * k / 100;
+    GrooveSection g;
+    g.ok = true;
+    const Eigen::Vector3d radial(-std::cos(a), 0, -std::sin(a));
+    g.root = Eigen::Vector3d(0, 0, 0.45) + 0.05 * radial;
+    g.tangent = Eigen::Vector3d(std::sin(a), 0, -std::cos(a));
+    g.normal = g.bisector = radial;
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  for (const Waypoint& w : seam_trajectory(s, RobustParams{}).waypoints) {
+    EXPECT_NEAR((w.position - Eigen::Vector3d(0, 0, 0.45)).norm(), 0.05, 0.00005);
+  }
+}
+
 TEST(RobustTrajectory, TooShortSeamThrowsNoGroove) {
   SeamCandidate s;
   s.sections.resize(1);

@@ -43,11 +43,14 @@ struct RobustParams {
   /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
   /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
   double scale = 0.010;
-  double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
-  double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
-  double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
-  double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
-  double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
+  double cell = 0.001;       ///< voxel edge of the coarse cloud the candidates live on (m)
+  double threshold_k = 4.0;  ///< candidate: concavity > median + k * robust sigma
+  double station = 0.0015;   ///< spacing of the fitted cross-sections along a seam (m)
+  double slab = 0.0015;      ///< half-thickness of a cross-section along the seam (m)
+  double smooth = 0.006;     ///< half-window of the smoothing along the seam (m)
+  /// Half-window of the torch path's smoothing in depth, along the top normal (m;
+  /// docs/method-robust.md, "Trajectory").
+  double depth_smooth = 0.024;
   double min_length = 0.015;  ///< seams shorter than this are rejected (m)
   double step = 0.002;        ///< waypoint spacing along the seam (m)
   int slices = 0;             ///< > 0: this many equal arc-length parts instead of `step`
