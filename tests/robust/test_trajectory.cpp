@@ -172,6 +172,27 @@ TEST(RobustTrajectory, BlendingLeavesAStraightSeamsOrientation) {
   EXPECT_LT(max_rotation_rate(b).deg_per_mm, 1e-6);
 }
 
+// An L whose corner point lies 1 mm beyond the second leg (its lines and the first leg's meet
+// there, its roots run 1 mm short of it): the path does not go out to the corner and back.
+TEST(RobustTrajectory, ACornerThatFoldsBackIsCut) {
+  SeamCandidate s = l_corner();
+  for (GrooveSection& g : s.sections) {
+    if (g.root.y() > 0) g.root.x() -= 0.001;
+  }
+  RobustParams p;
+  const Trajectory t = seam_trajectory(s, p);
+  for (std::size_t k = 1; k + 1 < t.waypoints.size(); ++k) {
+    const Eigen::Vector3d a = t.waypoints[k].position - t.waypoints[k - 1].position;
+    const Eigen::Vector3d b = t.waypoints[k + 1].position - t.waypoints[k].position;
+    EXPECT_GT(a.dot(b), 0.0) << k;  // never back the way it came
+  }
+  p.orientation_blend = 0;
+  p.depth_smooth = 0;  // the legs' tilted normals would lift the corner's roots
+  const Trajectory sharp = seam_trajectory(s, p);
+  // The corner point is dropped: from the first leg's last root straight to the second's first.
+  EXPECT_NEAR(sharp.length, 2 * 0.0585 + std::hypot(0.0005, 0.0015), 1e-9);
+}
+
 // A flat straight seam whose roots wave up and down by +-0.5 mm (period 15 mm, a D415's
 // undulation) comes out within +-0.1 mm; the waves across the seam stay (the path follows the
 // sections across), and RobustParams::depth_smooth = 0 leaves the depth alone.

@@ -42,6 +42,26 @@ void orient_open(std::vector<GrooveSection>& secs) {
   if (backwards) std::reverse(secs.begin(), secs.end());
 }
 
+// Drops the roots where the path folds back on itself (the chords before and after turn by
+// more than 120 deg), until none does. At an L's corner the legs meet where their lines do,
+// and that point can lie half a millimetre beyond the first roots of the next leg: the path
+// went out to it and back, and the torch turned by its blended 8 deg within 0.75 mm there.
+void drop_folds(std::vector<GrooveSection>& secs, bool closed) {
+  const double cos_fold = std::cos(120.0 * M_PI / 180.0);
+  for (std::size_t k = closed ? 0 : 1; secs.size() > 3 && k < secs.size();) {
+    const std::size_t n = secs.size();
+    if (!closed && k + 1 >= n) break;
+    const Eigen::Vector3d a = secs[k].root - secs[(k + n - 1) % n].root;
+    const Eigen::Vector3d b = secs[(k + 1) % n].root - secs[k].root;
+    if (a.dot(b) < cos_fold * a.norm() * b.norm()) {
+      secs.erase(secs.begin() + static_cast<std::ptrdiff_t>(k));
+      k = k > (closed ? 0u : 1u) ? k - 1 : k;
+    } else {
+      ++k;
+    }
+  }
+}
+
 // The torch's path: the polyline through the roots (m; closed: back to the start) with its arc
 // length S (m), and at each root the wall bisector B and the travel tangent T. Tangents are
 // the sections' own, from the seam curve smoothed over 18 mm, turned along the travel: the
@@ -205,6 +225,7 @@ Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params
   } else {
     orient_open(secs);
   }
+  drop_folds(secs, closed);
   TorchPath path = torch_path(secs, closed);
   smooth_depth(path, params.depth_smooth, closed);
   blend_orientation(path, params.orientation_blend, closed);
