@@ -156,13 +156,23 @@ struct FlagCase {
 TEST_F(BadInput, BadFlagValues) {
   const std::string scan = good_scan().string();
   const FlagCase cases[] = {
-      {"--radius abc", "--radius"},       {"--radius -1", "--radius"},
-      {"--radius 3", "out of range"},     {"--threshold high", "--threshold"},
-      {"--slices 0", "--slices"},         {"--slices 2.5", "integer"},
-      {"--units km", "--units"},          {"--backend gpu", "--backend"},
-      {"--method magic", "--method"},     {"--viewpoint 1,2", "--viewpoint"},
-      {"--smooth maybe", "--smooth"},     {"--no-such-flag 1", "no-such-flag"},
-      {"--weld-speed 0", "--weld-speed"}, {"--hand-eye he.yaml", "--flange-pose"},
+      {"--radius abc", "--radius"},
+      {"--radius -1", "--radius"},
+      {"--radius 3", "out of range"},
+      {"--threshold high", "--threshold"},
+      {"--slices 0", "--slices"},
+      {"--slices 2.5", "integer"},
+      {"--units km", "--units"},
+      {"--backend gpu", "--backend"},
+      {"--method magic", "--method"},
+      {"--viewpoint 1,2", "--viewpoint"},
+      {"--smooth maybe", "--smooth"},
+      {"--no-such-flag 1", "no-such-flag"},
+      {"--weld-speed 0", "--weld-speed"},
+      {"--hand-eye he.yaml", "--flange-pose"},
+      {"--orientation-blend -0.01", "--orientation-blend"},
+      {"--orientation-blend nan", "--orientation-blend"},
+      {"--orientation-blend wide", "--orientation-blend"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.flags);
@@ -183,6 +193,8 @@ TEST_F(BadInput, BadConfigFiles) {
   expect_failure(scan + " --config " + write("c1.yaml", "radius: [1, 2\n").string(), 3, "c1.yaml");
   expect_failure(scan + " --config " + write("c2.yaml", "radiuss: 0.003\n").string(), 2, "radiuss");
   expect_failure(scan + " --config " + write("c3.json", "{\"slices\": -4}").string(), 2, "slices");
+  expect_failure(scan + " --config " + write("c4.yaml", "orientation_blend: -1\n").string(), 2,
+                 "orientation_blend");
   expect_failure(scan + " --config " + (dir_ / "missing.yaml").string(), 3, "missing.yaml");
 }
 

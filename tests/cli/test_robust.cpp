@@ -71,7 +71,20 @@ TEST_F(CliRobust, GrooveOnABoxWithReportedCandidates) {
   EXPECT_NEAR(seams[0]["width_m"].get<double>(), 0.010, 0.0015);
   for (std::size_t k = 1; k < seams.size(); ++k) {
     EXPECT_LE(seams[k]["score"].get<double>(), seams[0]["score"].get<double>());
+    if (seams[k]["file"].is_null()) {
+      EXPECT_TRUE(seams[k]["max_rotation_deg_per_mm"].is_null());
+    }
   }
+  // The torch's fastest turn, per exported seam and at the top level: a straight groove on a
+  // flat top turns it by little.
+  const double rate = seams[0]["max_rotation_deg_per_mm"].get<double>();
+  EXPECT_GE(rate, 0.0);
+  EXPECT_LT(rate, 5.0);
+  EXPECT_EQ(report["trajectory"]["max_rotation_deg_per_mm"].get<double>(), rate);
+  const double at = report["trajectory"]["max_rotation_at_m"].get<double>();
+  EXPECT_GE(at, 0.0);
+  EXPECT_LE(at, report["trajectory"]["length_m"].get<double>() + 1e-9);
+  EXPECT_EQ(report["parameters"]["orientation_blend"].get<double>(), 0.025);
   // Waypoints every 2 mm along the groove (world x at y = 0 on the block's top).
   const auto poses = csv_positions(out / "trajectory.csv");
   ASSERT_GT(poses.size(), 40u);

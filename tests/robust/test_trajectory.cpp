@@ -96,6 +96,153 @@ TEST(RobustTrajectory, ClosedSeamReturnsToItsStart) {
   EXPECT_NEAR(t.waypoints.front().position.x(), -0.04, 1e-4);
 }
 
+// An L: 60 mm along +x, a 90 deg corner at the origin, 60 mm along +y; sections every 1.5 mm,
+// the bisector tilted 10 deg across the first leg. Tangent signs carry no meaning.
+SeamCandidate l_corner() {
+  SeamCandidate s;
+  const Eigen::Vector3d up(0, std::sin(10 * M_PI / 180), -std::cos(10 * M_PI / 180));
+  for (int k = -40; k <= 40; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    const double d = 0.0015 * std::abs(k);
+    g.root = k <= 0 ? Eigen::Vector3d(-d, 0, 0.4) : Eigen::Vector3d(0, d, 0.4);
+    g.tangent = Eigen::Vector3d(k <= 0 ? 1 : 0, k <= 0 ? 0 : 1, 0) * (k % 3 ? 1 : -1);
+    g.normal = g.bisector = k <= 0 ? up : Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  return s;
+}
+
+// Through a corner the torch turns over the blend length (orientation_blend), at no more than
+// 1.5 times 90 deg / blend per millimetre; without blending it turns within one step. The
+// positions do not change.
+TEST(RobustTrajectory, OrientationTurnsThroughACornerOverTheBlendLength) {
+  RobustParams p;
+  for (double blend : {0.01, 0.025, 0.05}) {
+    SCOPED_TRACE(blend);
+    p.orientation_blend = blend;
+    const Trajectory t = seam_trajectory(l_corner(), p);
+    const RotationRate r = max_rotation_rate(t);
+    EXPECT_LE(r.deg_per_mm, 1.5 * 90.0 / (1000 * blend));
+    EXPECT_NEAR(r.at_m, 0.06, 0.5 * blend);
+    // The whole turn still happens: tool x along each leg at the ends, z into the workpiece.
+    const Eigen::Matrix3d R0 = t.waypoints.front().orientation.toRotationMatrix();
+    const Eigen::Matrix3d R1 = t.waypoints.back().orientation.toRotationMatrix();
+    EXPECT_GT(R0.col(0).x(), 0.9999);
+    EXPECT_GT(R1.col(0).y(), 0.9999);
+    for (const Waypoint& w : t.waypoints) {
+      EXPECT_GT(w.orientation.toRotationMatrix().col(2).z(), 0.98);
+    }
+  }
+  p.orientation_blend = 0;
+  const Trajectory sharp = seam_trajectory(l_corner(), p);
+  EXPECT_GT(max_rotation_rate(sharp).deg_per_mm, 20.0);
+  p.orientation_blend = 0.025;
+  const Trajectory blended = seam_trajectory(l_corner(), p);
+  ASSERT_EQ(sharp.waypoints.size(), blended.waypoints.size());
+  for (std::size_t k = 0; k < sharp.waypoints.size(); ++k) {
+    EXPECT_EQ(sharp.waypoints[k].position, blended.waypoints[k].position) << k;
+  }
+}
+
+// A straight seam with a constant (tilted) bisector keeps its orientation when blended.
+TEST(RobustTrajectory, BlendingLeavesAStraightSeamsOrientation) {
+  SeamCandidate s;
+  const Eigen::Vector3d up = Eigen::Vector3d(0.1, 0.3, -1).normalized();
+  for (int k = 0; k <= 100; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(-0.075 + 0.0015 * k, 0.0, 0.4 + 0.0003 * k);
+    g.tangent = Eigen::Vector3d(1, 0, 0.2).normalized() * (k % 3 ? 1 : -1);
+    g.normal = g.bisector = up;
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  RobustParams p;
+  p.orientation_blend = 0;
+  const Trajectory a = seam_trajectory(s, p);
+  p.orientation_blend = 0.05;
+  const Trajectory b = seam_trajectory(s, p);
+  ASSERT_EQ(a.waypoints.size(), b.waypoints.size());
+  for (std::size_t k = 0; k < a.waypoints.size(); ++k) {
+    EXPECT_LT(a.waypoints[k].orientation.angularDistance(b.waypoints[k].orientation), 1e-9) << k;
+    EXPECT_EQ(a.waypoints[k].position, b.waypoints[k].position) << k;
+  }
+  EXPECT_LT(max_rotation_rate(b).deg_per_mm, 1e-6);
+}
+
+// An L whose corner point lies 1 mm beyond the second leg (its lines and the first leg's meet
+// there, its roots run 1 mm short of it): the path does not go out to the corner and back.
+TEST(RobustTrajectory, ACornerThatFoldsBackIsCut) {
+  SeamCandidate s = l_corner();
+  for (GrooveSection& g : s.sections) {
+    if (g.root.y() > 0) g.root.x() -= 0.001;
+  }
+  RobustParams p;
+  const Trajectory t = seam_trajectory(s, p);
+  for (std::size_t k = 1; k + 1 < t.waypoints.size(); ++k) {
+    const Eigen::Vector3d a = t.waypoints[k].position - t.waypoints[k - 1].position;
+    const Eigen::Vector3d b = t.waypoints[k + 1].position - t.waypoints[k].position;
+    EXPECT_GT(a.dot(b), 0.0) << k;  // never back the way it came
+  }
+  p.orientation_blend = 0;
+  p.depth_smooth = 0;  // the legs' tilted normals would lift the corner's roots
+  const Trajectory sharp = seam_trajectory(s, p);
+  // The corner point is dropped: from the first leg's last root straight to the second's first.
+  EXPECT_NEAR(sharp.length, 2 * 0.0585 + std::hypot(0.0005, 0.0015), 1e-9);
+}
+
+// A flat straight seam whose roots wave up and down by +-0.5 mm (period 15 mm, a D415's
+// undulation) comes out within +-0.1 mm; the waves across the seam stay (the path follows the
+// sections across), and RobustParams::depth_smooth = 0 leaves the depth alone.
+TEST(RobustTrajectory, DepthIsSmoothedAlongAFlatSeam) {
+  SeamCandidate s;
+  for (int k = 0; k <= 200; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    const double x = -0.15 + 0.0015 * k, wave = 0.0005 * std::sin(2 * M_PI * x / 0.015);
+    g.root = Eigen::Vector3d(x, 0.2 * wave, 0.4 + wave);
+    g.tangent = Eigen::Vector3d(1, 0, 0);
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  RobustParams p;
+  double inner = 0, across = 0, raw = 0;
+  for (const Waypoint& w : seam_trajectory(s, p).waypoints) {
+    if (std::abs(w.position.x()) < 0.1) inner = std::max(inner, std::abs(w.position.z() - 0.4));
+    across = std::max(across, std::abs(w.position.y()));
+  }
+  p.depth_smooth = 0;
+  for (const Waypoint& w : seam_trajectory(s, p).waypoints) {
+    raw = std::max(raw, std::abs(w.position.z() - 0.4));
+  }
+  EXPECT_LT(inner, 0.0001);
+  EXPECT_GT(across, 0.00009);
+  EXPECT_GT(raw, 0.00045);
+}
+
+// A seam that curves in depth (half a ring of radius 50 mm round a pipe, the normal radial)
+// keeps its shape: the quadratic follows the curvature.
+TEST(RobustTrajectory, DepthSmoothingFollowsAPipe) {
+  SeamCandidate s;
+  for (int k = 0; k <= 100; ++k) {
+    const double a = M_PI * k / 100;
+    GrooveSection g;
+    g.ok = true;
+    const Eigen::Vector3d radial(-std::cos(a), 0, -std::sin(a));
+    g.root = Eigen::Vector3d(0, 0, 0.45) + 0.05 * radial;
+    g.tangent = Eigen::Vector3d(std::sin(a), 0, -std::cos(a));
+    g.normal = g.bisector = radial;
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  for (const Waypoint& w : seam_trajectory(s, RobustParams{}).waypoints) {
+    EXPECT_NEAR((w.position - Eigen::Vector3d(0, 0, 0.45)).norm(), 0.05, 0.00005);
+  }
+}
+
 TEST(RobustTrajectory, TooShortSeamThrowsNoGroove) {
   SeamCandidate s;
   s.sections.resize(1);

@@ -39,7 +39,7 @@ struct PaperParams {
 
 /// The robust method's parameters (`--method robust`, docs/method-robust.md). The defaults are
 /// the one configuration used on every shape, distance, tilt and resolution; only `step`,
-/// `slices` and `max_seams` are run parameters (flags).
+/// `slices`, `max_seams` and `orientation_blend` are run parameters (flags).
 struct RobustParams {
   /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
   /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
@@ -52,10 +52,19 @@ struct RobustParams {
   double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
   double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
   double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
+  /// Half-window of the torch path's smoothing in depth, along the top normal (m;
+  /// docs/method-robust.md, "Trajectory").
+  double depth_smooth = 0.024;
   double min_length = 0.015;  ///< seams shorter than this are rejected (m)
   double step = 0.002;        ///< waypoint spacing along the seam (m)
   int slices = 0;             ///< > 0: this many equal arc-length parts instead of `step`
   int max_seams = 1;          ///< seams exported as trajectories, best first
+  /// Arc length (m) over which the torch's orientation is blended either side of each point (a
+  /// triangle-weighted mean of the wall bisector and the travel tangent; 0 = none): through a
+  /// corner the torch turns at about turn / blend, for 90 deg at most 1.27 times that - 4.6
+  /// deg/mm at 0.025 m, 37 deg/s at the default weld speed of 8 mm/s (docs/method-robust.md,
+  /// "Trajectory").
+  double orientation_blend = 0.025;
 };
 
 /// The robot program's motion and arc settings (URScript, urscript.hpp).

@@ -80,10 +80,11 @@ struct SeamCandidate {
   std::string reason;  ///< why rejected (empty when accepted)
 };
 
-/// Torch poses along a seam: positions on the smoothed root line every `step` (or in
-/// `slices` equal parts), tool z = -wall bisector, tool x along the seam; rotation vectors
-/// continuous. An open seam ends at larger x of the cloud's frame than it starts (ties: y, then
-/// z); a closed seam starts at its smallest x, runs counter-clockwise about its mean top
+/// Torch poses along a seam: positions on the smoothed root line (its height along the top
+/// normal smoothed further over `depth_smooth`) every `step` (or in `slices` equal parts), tool
+/// z = -wall bisector, tool x along the seam, both blended over `orientation_blend`; rotation
+/// vectors continuous. An open seam ends at larger x of the cloud's frame than it starts (ties: y,
+/// then z); a closed seam starts at its smallest x, runs counter-clockwise about its mean top
 /// normal and ends where it started.
 GT_API Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 

@@ -41,6 +41,16 @@ struct Trajectory {
 GT_API Eigen::Quaterniond tool_orientation(const Eigen::Vector3d& normal,
                                            const Eigen::Vector3d& travel);
 
+/// The fastest turn of the torch along a path: the largest rotation angle between consecutive
+/// waypoints divided by their distance, and where (arc length from the first waypoint to the
+/// pair's midpoint, along the waypoints). Pairs closer than 1 um are skipped; zero for fewer
+/// than two waypoints.
+struct RotationRate {
+  double deg_per_mm = 0.0;
+  double at_m = 0.0;
+};
+GT_API RotationRate max_rotation_rate(const Trajectory& trajectory);
+
 /// Fills rotation_vector (continuous along the path) and euler_zyx_deg from orientation.
 GT_API void fill_rotation_representations(Trajectory& trajectory);
 

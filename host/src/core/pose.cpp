@@ -69,4 +69,20 @@ void fill_rotation_representations(Trajectory& trajectory) {
   }
 }
 
+RotationRate max_rotation_rate(const Trajectory& trajectory) {
+  RotationRate worst;
+  const std::vector<Waypoint>& w = trajectory.waypoints;
+  double s = 0.0;
+  for (std::size_t k = 1; k < w.size(); ++k) {
+    const double d = (w[k].position - w[k - 1].position).norm();
+    if (d >= 1e-6) {
+      const double rate =
+          rad_to_deg(w[k - 1].orientation.angularDistance(w[k].orientation)) / (1000.0 * d);
+      if (rate > worst.deg_per_mm) worst = {rate, s + 0.5 * d};
+    }
+    s += d;
+  }
+  return worst;
+}
+
 }  // namespace groovetrace

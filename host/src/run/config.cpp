@@ -230,6 +230,10 @@ void add_waypoint_specs(std::vector<ParamSpec>& s) {
       integer(kRobust, "max_seams",
               "robust: seams exported, best first (trajectory.csv, then trajectory_1.csv...)",
               robust(&RobustParams::max_seams), 1, 100));
+  s.push_back(length(kRobust, "orientation_blend",
+                     "robust: arc length over which the torch's orientation turns through "
+                     "corners; 0 = no blending",
+                     robust(&RobustParams::orientation_blend), 0.0, 0.5));
   s.push_back(integer(kPaper, "median_max_iterations", "geometric-median iteration cap",
                       paper(&PaperParams::median_max_iterations), 1, 1000000));
   s.push_back(length(kPaper, "median_tolerance", "geometric-median stop step",

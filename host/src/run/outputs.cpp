@@ -41,7 +41,15 @@ json stations_json(const SeamCandidate& seam) {
   return out;
 }
 
-json seam_json(const SeamCandidate& s, std::size_t rank, const json& file) {
+// The fastest turn of the torch along `t` (deg/mm) and where (arc length, m); null without a
+// trajectory.
+void add_rotation_rate(json& j, const Trajectory* t) {
+  const RotationRate r = t ? max_rotation_rate(*t) : RotationRate{};
+  j["max_rotation_deg_per_mm"] = t ? finite_or_null(r.deg_per_mm) : json(nullptr);
+  j["max_rotation_at_m"] = t ? finite_or_null(r.at_m) : json(nullptr);
+}
+
+json seam_json(const SeamCandidate& s, std::size_t rank, const json& file, const Trajectory* t) {
   auto num = finite_or_null;
   json j = {{"rank", rank},
             {"accepted", s.accepted},
@@ -62,22 +70,28 @@ json seam_json(const SeamCandidate& s, std::size_t rank, const json& file) {
             {"scale_m", num(s.scale)},
             {"file", file}};
   if (!file.is_null()) j["stations"] = stations_json(s);
+  add_rotation_rate(j, t);
   return j;
 }
 
 // report.json "robust": the candidate threshold and every candidate seam with its score
-// (docs/method-robust.md, "Score"), best first; `file` names the trajectory written for it.
-json robust_report(const RobustDetection& rd, int max_seams) {
+// (docs/method-robust.md, "Score"), best first; `file` names the trajectory written for it
+// (`trajectories`, in that order), whose fastest turn is reported with it.
+json robust_report(const RobustDetection& rd, const std::vector<Trajectory>& trajectories,
+                   int max_seams) {
   json seams = json::array();
   int exported = 0;
   for (std::size_t k = 0; k < rd.seams.size(); ++k) {
     const SeamCandidate& s = rd.seams[k];
     json file = nullptr;
+    const Trajectory* t = nullptr;
     if (s.accepted && exported < max_seams) {
       file = exported == 0 ? "trajectory.csv" : "trajectory_" + std::to_string(exported) + ".csv";
+      const auto e = static_cast<std::size_t>(exported);
+      t = e < trajectories.size() ? &trajectories[e] : nullptr;
       ++exported;
     }
-    seams.push_back(seam_json(s, k, file));
+    seams.push_back(seam_json(s, k, file, t));
   }
   json scales = json::array();
   for (const ScaleSearchSummary& sc : rd.scales) {
@@ -146,21 +160,22 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   for (const auto& [stage, ms] : result.timings_ms) timings[stage] = ms;
   timings["total"] = total_ms;
   const Trajectory& best = result.trajectories.front();
-  json report = {
-      {"version", version()},
-      {"input", input_path},
-      {"method", to_string(result.method)},
-      {"backend", result.backend},
-      {"device", result.device},
-      {"parameters", json::parse(params_json(params))},
-      {"points", points_report(input, result)},
-      {"detection", detection_report(result, params)},
-      {"trajectory",
-       {{"frame", best.frame}, {"waypoints", best.waypoints.size()}, {"length_m", best.length}}},
-      {"timings_ms", timings},
-      {"warnings", result.warnings}};
+  json trajectory = {
+      {"frame", best.frame}, {"waypoints", best.waypoints.size()}, {"length_m", best.length}};
+  add_rotation_rate(trajectory, &best);
+  json report = {{"version", version()},
+                 {"input", input_path},
+                 {"method", to_string(result.method)},
+                 {"backend", result.backend},
+                 {"device", result.device},
+                 {"parameters", json::parse(params_json(params))},
+                 {"points", points_report(input, result)},
+                 {"detection", detection_report(result, params)},
+                 {"trajectory", trajectory},
+                 {"timings_ms", timings},
+                 {"warnings", result.warnings}};
   if (result.method == Method::robust) {
-    report["robust"] = robust_report(result.robust, params.robust.max_seams);
+    report["robust"] = robust_report(result.robust, result.trajectories, params.robust.max_seams);
   }
   return report.dump(2) + "\n";
 }
