@@ -47,11 +47,11 @@ struct RobustParams {
   /// The scales searched (m), each with voxels of max(cell, scale / 10); a groove is kept at
   /// the scale that fits it best (docs/method-robust.md, "Scales"). Empty: `scale` alone.
   std::vector<double> scales = {0.005, 0.010, 0.020, 0.040};
-  double cell = 0.001;        ///< voxel edge of the coarse cloud the candidates live on (m)
-  double threshold_k = 4.0;   ///< candidate: concavity > median + k * robust sigma
-  double station = 0.0015;    ///< spacing of the fitted cross-sections along a seam (m)
-  double slab = 0.0015;       ///< half-thickness of a cross-section along the seam (m)
-  double smooth = 0.006;      ///< half-window of the smoothing along the seam (m)
+  double cell = 0.001;       ///< voxel edge of the coarse cloud the candidates live on (m)
+  double threshold_k = 4.0;  ///< candidate: concavity > median + k * robust sigma
+  double station = 0.0015;   ///< spacing of the fitted cross-sections along a seam (m)
+  double slab = 0.0015;      ///< half-thickness of a cross-section along the seam (m)
+  double smooth = 0.006;     ///< half-window of the smoothing along the seam (m)
   /// Half-window of the torch path's smoothing in depth, along the top normal (m;
   /// docs/method-robust.md, "Trajectory").
   double depth_smooth = 0.024;
