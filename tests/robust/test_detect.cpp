@@ -207,17 +207,23 @@ std::pair<double, double> path_errors(const Trajectory& t, const Seam& truth) {
   return {dist / n, angle / n};
 }
 
+// A 640x480 scan of a straight joint at 0.4 m with `seed`, for the joints below.
+SynthParams vga_joint(std::uint64_t seed) {
+  SynthParams sp;
+  sp.width = 640;
+  sp.height = 480;
+  sp.seed = seed;
+  return sp;
+}
+
 // A single bevel (45 deg, 8 mm deep) seen from above: its square side returns nothing. Read
 // as a symmetric V, the path ran halfway up the inclined wall (3.7 mm across and 3.5 mm above
 // the root) with the torch 22.5 deg off the joint's bisector.
 TEST(RobustDetect, SingleBevelIsFoundAtTheFootOfItsSquareSide) {
-  SynthParams sp;
+  SynthParams sp = vga_joint(11);
   sp.joint = JointType::kBevel;
   sp.groove_angle_deg = 45;
   sp.groove_width = 0.0085;
-  sp.width = 640;
-  sp.height = 480;
-  sp.seed = 11;
   const SynthScan scan = render(sp);
   const RobustParams p;
   const RobustDetection d = detect_robust(scan.cloud, p);
@@ -232,12 +238,9 @@ TEST(RobustDetect, SingleBevelIsFoundAtTheFootOfItsSquareSide) {
 // A 100 mm wide panel joint (150 deg): ten times the width the default scale's window holds;
 // the search at a larger scale finds it.
 TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {
-  SynthParams sp;
+  SynthParams sp = vga_joint(12);
   sp.groove_width = 0.10;
   sp.groove_angle_deg = 150;
-  sp.width = 640;
-  sp.height = 480;
-  sp.seed = 12;
   const SynthScan scan = render(sp);
   const RobustParams p;
   const RobustDetection d = detect_robust(scan.cloud, p);

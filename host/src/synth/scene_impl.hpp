@@ -129,8 +129,8 @@ struct PathPiece {
 
 using Path = std::vector<PathPiece>;
 
-// Signed distance to a whole path: that of its nearest piece.
-inline double path_signed_distance(const Path& path, const Eigen::Vector2d& p) {
+// The piece of a path nearest to p.
+inline const PathPiece& nearest_path_piece(const Path& path, const Eigen::Vector2d& p) {
   const PathPiece* best = &path.front();
   double d = kInf;
   for (const PathPiece& piece : path) {
@@ -140,20 +140,16 @@ inline double path_signed_distance(const Path& path, const Eigen::Vector2d& p) {
       best = &piece;
     }
   }
-  return best->signed_distance(p);
+  return *best;
+}
+
+// Signed distance to a whole path: that of its nearest piece.
+inline double path_signed_distance(const Path& path, const Eigen::Vector2d& p) {
+  return nearest_path_piece(path, p).signed_distance(p);
 }
 
 inline Eigen::Vector2d path_tangent(const Path& path, const Eigen::Vector2d& p) {
-  const PathPiece* best = &path.front();
-  double d = kInf;
-  for (const PathPiece& piece : path) {
-    const double di = piece.distance(p);
-    if (di < d) {
-      d = di;
-      best = &piece;
-    }
-  }
-  return best->tangent(p);
+  return nearest_path_piece(path, p).tangent(p);
 }
 
 enum class Body { kBox, kPipe };
