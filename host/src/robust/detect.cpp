@@ -27,13 +27,14 @@ void per_point_fields(const Cloud& cloud, const CreaseMap& map, RobustDetection&
   }
 }
 
-// The nodes whose V fit across their own direction passed (a thicker slab: one fit only):
-// each fit's root (m), tangent and top normal.
+// The nodes whose V fit across their own direction passed (a thicker slab: one fit only) with
+// a width (m) in the band [lo, hi) this scale reads: each fit's root (m), tangent and top
+// normal.
 struct ConfirmedNodes {
   std::vector<Eigen::Vector3d> roots, tangents, normals;
 };
 
-ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes) {
+ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes, double lo, double hi) {
   const std::size_t nn = nodes.voxel.size();
   std::vector<GrooveSection> checks(nn);
   const std::int64_t count = static_cast<std::int64_t>(nn);
@@ -50,7 +51,7 @@ ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes) {
   }
   ConfirmedNodes out;
   for (const GrooveSection& c : checks) {
-    if (!c.ok) continue;
+    if (!c.ok || c.width < lo || c.width >= hi) continue;
     out.roots.push_back(c.root);
     out.tangents.push_back(c.tangent);
     out.normals.push_back(c.normal);
@@ -94,6 +95,7 @@ RobustParams at_scale(const RobustParams& params, double scale) {
 // One scale's search: candidates and crease nodes, then seams traced from them and scored.
 struct ScaleSearch {
   RobustParams params;
+  double lo = 0, hi = INFINITY;  // the groove widths it traces (m; see width_bands)
   CreaseMap map;
   CreaseNodes nodes;
   ScaleSearchSummary summary;
@@ -101,7 +103,7 @@ struct ScaleSearch {
 };
 
 ScaleSearch find_creases(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend) {
-  ScaleSearch out{params, crease_map(cloud, params, backend), {}, {}, {}};
+  ScaleSearch out{params, 0, INFINITY, crease_map(cloud, params, backend), {}, {}, {}};
   ScaleSearchSummary& sum = out.summary;
   sum.scale = params.scale;
   sum.cell = params.cell;
@@ -121,7 +123,7 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
                     NeighborGrid(voxel_cloud(search.map), static_cast<float>(params.scale)),
                     BoxBins(cloud, 0.25 * params.scale),
                     2 * params.scale};
-  const ConfirmedNodes confirmed = confirm_nodes(ctx, search.nodes);
+  const ConfirmedNodes confirmed = confirm_nodes(ctx, search.nodes, search.lo, search.hi);
   search.summary.confirmed_nodes = confirmed.roots.size();
   search.seams = trace_seams(ctx, confirmed, 1.5 * params.scale);
   for (SeamCandidate& seam : search.seams) {
@@ -129,6 +131,18 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
     seam.scale = params.scale;
   }
   search.summary.seams = search.seams.size();
+}
+
+// Each scale (ascending) traces only the nodes whose fitted width it holds (up to
+// kWidthPerScale times the scale; the coarsest, any width) and that the next finer scale does
+// not (above three quarters of that scale's limit: a quarter overlaps, so that a groove whose
+// width lies at a limit is traced whole at one scale at least). A 10 mm groove is then traced
+// at 10 mm only, not again at 5 and 20 mm to be dropped as a repeat.
+void width_bands(std::vector<ScaleSearch>& searches) {
+  for (std::size_t k = 0; k < searches.size(); ++k) {
+    if (k > 0) searches[k].lo = 0.75 * kWidthPerScale * searches[k - 1].params.scale;
+    if (k + 1 < searches.size()) searches[k].hi = kWidthPerScale * searches[k].params.scale;
+  }
 }
 
 // A seam fits the scale it was found at when the window holds its groove with top surface to
@@ -182,9 +196,11 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
   if (std::find(scales.begin(), scales.end(), params.scale) == scales.end()) {
     scales.push_back(params.scale);
   }
+  std::sort(scales.begin(), scales.end());
   std::vector<ScaleSearch> searches;
   for (double scale : scales)
     searches.push_back(find_creases(cloud, at_scale(params, scale), backend));
+  width_bands(searches);
   if (lap) lap("candidates");
   std::vector<SeamCandidate> all;
   for (ScaleSearch& search : searches) {

@@ -19,7 +19,7 @@ GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
   const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
   // The ball holds the window across, the slab along and the groove's depth below.
   const double radius = 1.3 * ctx.half_window + slab;
-  ctx.bins.within(ctx.cloud, origin, radius, scratch);
+  ctx.bins.within_slab(ctx.cloud, origin, radius, t.normalized(), slab, scratch);
   return fit_section(ctx.cloud, scratch, origin, t, normal, slab, ctx.half_window, mode);
 }
 
@@ -58,9 +58,11 @@ OkMedians ok_medians(const std::vector<GrooveSection>& secs) {
 GrooveSection gap_section_at(const Context& ctx, const Eigen::Vector3d& origin,
                              const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal,
                              const OkMedians& med, std::vector<std::uint32_t>& scratch) {
-  ctx.bins.within(ctx.cloud, origin, 1.3 * ctx.half_window + ctx.params.slab, scratch);
-  return fit_gap_section(ctx.cloud, scratch, origin, surface_tangent(ctx, origin, tangent, normal),
-                         normal, ctx.params.slab, ctx.half_window, med.width, med.depth);
+  const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
+  ctx.bins.within_slab(ctx.cloud, origin, 1.3 * ctx.half_window + ctx.params.slab, t.normalized(),
+                       ctx.params.slab, scratch);
+  return fit_gap_section(ctx.cloud, scratch, origin, t, normal, ctx.params.slab, ctx.half_window,
+                         med.width, med.depth);
 }
 
 // The index of the point of `points` nearest to p (the first of equals).
