@@ -36,15 +36,9 @@ class BoxBins {
     }
   }
 
-  /// Indices of the points within `radius` (m) of q, appended to `out` (cleared first).
-  void within(const Cloud& cloud, const Eigen::Vector3d& q, double radius,
-              std::vector<std::uint32_t>& out) const {
-    within_slab(cloud, q, radius, Eigen::Vector3d::UnitX(), INFINITY, out);
-  }
-
   /// The points within `radius` (m) of q that also lie within `slab` (m) of the plane through
-  /// q normal to the unit vector `t`, appended to `out` (cleared first), in the order `within`
-  /// gives them. A section's slab is a few millimetres thick in a ball of up to a decimetre:
+  /// q normal to the unit vector `t`, appended to `out` (cleared first), cell by cell (z, y, x
+  /// ascending). A section's slab is a few millimetres thick in a ball of up to a decimetre:
   /// only the cells the plane passes near are visited.
   void within_slab(const Cloud& cloud, const Eigen::Vector3d& q, double radius,
                    const Eigen::Vector3d& t, double slab, std::vector<std::uint32_t>& out) const {

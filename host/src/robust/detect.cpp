@@ -133,17 +133,15 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
   search.summary.seams = search.seams.size();
 }
 
-// Each scale (ascending) but the `base` one traces only the nodes whose fitted width it holds
-// (up to kWidthPerScale times the scale; the coarsest, any width) and that the next finer
-// scale does not (above three quarters of that scale's limit). A 10 mm groove is then traced
-// at 10 mm, not again at 5 and 20 mm to be dropped as a repeat. The base scale traces every
-// node: a single node's width is noisy (at 640x480 and 0.55 m a 10 mm groove's nodes read
-// 4-18 mm), and leaving the noisy ones out cut its seams short.
+// The scales finer than `base` trace only the nodes whose fitted width they hold (up to
+// kWidthPerScale times the scale): a 10 mm groove is not traced again at 5 mm to be dropped
+// as a repeat. The base and coarser scales trace every node: a single node's width is noisy
+// (at 640x480 and 0.55 m a 10 mm groove's nodes read 4-18 mm), and a groove the base scale
+// does not accept may still be read at a coarser one (a single bevel 8.5 mm wide at 1280x720
+// was found at 20 mm only; cut from 20 mm as "narrower than that scale's band", it was lost).
 void width_bands(std::vector<ScaleSearch>& searches, double base) {
-  for (std::size_t k = 0; k < searches.size(); ++k) {
-    if (searches[k].params.scale == base) continue;
-    if (k > 0) searches[k].lo = 0.75 * kWidthPerScale * searches[k - 1].params.scale;
-    if (k + 1 < searches.size()) searches[k].hi = kWidthPerScale * searches[k].params.scale;
+  for (ScaleSearch& s : searches) {
+    if (s.params.scale < base) s.hi = kWidthPerScale * s.params.scale;
   }
 }
 

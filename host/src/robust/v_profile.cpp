@@ -395,8 +395,13 @@ bool fit_top(ProfileFit& f, Eigen::Vector3d& q) {
   if (n_left < 3 && n_right < 3) return false;
   f.top_step = top_step(f.outer);
   f.step = f.stepped ? f.top_step : 0.0;
-  std::vector<Eigen::Vector2d> level = f.outer;  // the right side lowered by the step
-  for (auto& p : level) p.y() -= f.top(Eigen::Vector3d::Zero(), p.x());
+  // The right side lowered by the step (a copy only when there is one: this runs per section).
+  std::vector<Eigen::Vector2d> lowered;
+  if (f.step != 0.0) {
+    lowered = f.outer;
+    for (auto& p : lowered) p.y() -= f.top(Eigen::Vector3d::Zero(), p.x());
+  }
+  const std::vector<Eigen::Vector2d>& level = f.step != 0.0 ? lowered : f.outer;
   std::pair<Eigen::Vector3d, double> top = fit_poly(level, n_left >= 3 && n_right >= 3 ? 2 : 1);
   if (std::abs(top.first[2]) > 0.5 / f.W) top = fit_poly(level, 1);
   q = top.first;
