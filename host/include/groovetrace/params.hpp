@@ -39,7 +39,7 @@ struct PaperParams {
 
 /// The robust method's parameters (`--method robust`, docs/method-robust.md). The defaults are
 /// the one configuration used on every shape, distance, tilt and resolution; only `step`,
-/// `slices`, `max_seams` and `orientation_blend` are run parameters (flags).
+/// `slices`, `max_seams`, `orientation_blend` and `fillet_leg` are run parameters (flags).
 struct RobustParams {
   /// Radius of the concavity measure and half of a cross-section's window (m): grooves up to
   /// about 1.6 times this wide fit the window (docs/method-robust.md, "One configuration").
@@ -65,6 +65,9 @@ struct RobustParams {
   /// deg/mm at 0.025 m, 37 deg/s at the default weld speed of 8 mm/s (docs/method-robust.md,
   /// "Trajectory").
   double orientation_blend = 0.025;
+  /// The leg of the fillet weld on a corner joint (fillet or lap; m): its ends on the two faces
+  /// bound the joint region and the weld face between them (z7, a throat of 5 mm at 90 deg).
+  double fillet_leg = 0.007;
 };
 
 /// The robot program's motion and arc settings (URScript, urscript.hpp).

@@ -43,6 +43,11 @@ struct GrooveSection {
   bool square_side = false;
   double wall_left_deg = 0, wall_right_deg = 0;  ///< each wall's dip below the top (deg)
   double misalignment = 0;  ///< top on the right (across) side minus the left's (m): high-low
+  /// A concave corner between two faces (a fillet or lap joint), not a V: the edges are the
+  /// weld's leg ends on the faces, `normal` and `bisector` the corner's bisector.
+  bool corner = false;
+  /// With corner: one face ends inside the window, where the upper plate of a lap joint begins.
+  bool short_face = false;
   /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
   /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
   bool inferred = false;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/neighbor_grid.hpp"
@@ -65,5 +66,23 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
 /// seam: a seam is dropped when half or more of its root line runs within the groove (half its
 /// width, at least 3 mm) of a seam kept before it. Order kept.
 std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked);
+
+// --- support.cpp ----------------------------------------------------------------------------
+
+/// A plane: a point on it (m) and its unit normal, towards the viewpoint.
+struct SupportPlane {
+  Eigen::Vector3d point, normal;
+};
+
+/// The table the workpiece stands on, if seen: of the planes through the voxels of `map` (each
+/// with its own normal, refitted to the voxels within 2 mm) that hold at least 15 % of them and
+/// have at most 2 % behind them, the farthest from the viewpoint.
+std::optional<SupportPlane> support_plane(const CreaseMap& map);
+
+/// Corner roots this near the support plane (m) are a part's foot on the table.
+constexpr double kFootHeight = 0.003;
+
+/// Unaccepts the fillet and lap seams most of whose roots lie within kFootHeight of `plane`.
+void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& seams);
 
 }  // namespace groovetrace::robust_detail

@@ -24,17 +24,27 @@ double relative_spread(const std::vector<double>& v) {
 // A single bevel has one side square to the top (its dip over 75 deg: a wall measured steep
 // or a hidden side whose mirror image would have been seen) and the other at least 20 deg
 // flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
+// A corner (no top across it) is a fillet, or a lap where one face, the upper plate's edge,
+// ends inside the window: each by the majority of the sections that passed.
 std::string joint_kind(const std::vector<GrooveSection>& secs) {
   std::vector<double> steep, flat;
+  std::size_t corners = 0, short_faces = 0;
   for (const GrooveSection& s : secs) {
     if (!s.ok) continue;
+    corners += s.corner;
+    short_faces += s.corner && s.short_face;
     steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
     flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
   }
+  if (2 * corners > steep.size()) return 2 * short_faces > corners ? "lap" : "fillet";
   if (steep.size() < 3) return "V";
   const double hi = upper_median(steep), lo = upper_median(flat);
   return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";
 }
+
+// Clamps and blocks standing on a part make corners 20-40 mm long that a cross-section cannot
+// tell from a fillet; a corner joint must be longer than that.
+constexpr double kMinCornerLength = 0.04;
 
 // Median |high-low| of the two-wall sections' top sides (m); 0 with none.
 double median_misalignment(const std::vector<GrooveSection>& secs) {
@@ -75,6 +85,8 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
     seam.reason = "fewer than 3 V-shaped sections";
   } else if (seam.length < params.min_length) {
     seam.reason = "shorter than min_length";
+  } else if ((seam.joint == "fillet" || seam.joint == "lap") && seam.length < kMinCornerLength) {
+    seam.reason = "a corner shorter than a fixture's (clamp, block)";
   } else if (seam.ok_fraction < 0.4) {
     seam.reason = "fewer than 40 % of the sections are V-shaped";
   } else if (seam.consistency < 0.35) {

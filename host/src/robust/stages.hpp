@@ -76,6 +76,12 @@ struct VProfile {
   bool square_side = false;
   /// The right top side's height minus the left's above the root (m): plates set high-low.
   double misalignment = 0.0;
+  /// A concave corner between two faces with no top (fit_corner_profile): a fillet or lap
+  /// joint. Edges are the weld's leg ends on the faces, `top` the weld face between them.
+  bool corner = false;
+  /// With corner: one face ends inside the window, where a face parallel to the other begins
+  /// (a lap's upper plate: its edge face, then its top).
+  bool short_face = false;
 };
 
 /// What a seam's first pass knows about its groove, for the second pass's fits.
@@ -88,6 +94,9 @@ struct VFit {
   /// height (their step held at what lines fitted to each side alone give), so the step does
   /// not tilt the top normal or move the edges. Not with `symmetric`.
   bool stepped = false;
+  /// The weld's leg on a corner joint (fillet or lap), m: where the V fails, a concave corner
+  /// is fitted instead and its opening is the weld face between the legs' ends.
+  double corner_leg = 0.007;
 };
 
 /// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust
@@ -101,6 +110,13 @@ struct VFit {
 /// wall hidden at a grazing angle from a square side that cannot be seen).
 VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& uv, double half_window, VFit mode = {},
                        const Eigen::Vector2d& view = Eigen::Vector2d(0, 1));
+
+/// Fits a concave corner (fillet or lap joint) to profile points within |u| <= half_window:
+/// two straight faces meeting at the root, each at least `leg` (m) long, 60-120 deg apart,
+/// open towards `view` (unit, towards the sensor), with no top surface or other face in the
+/// window. Edges at `leg` from the root along each face; bisector between the faces.
+VProfile fit_corner_profile(const std::vector<Eigen::Vector2d>& uv, double half_window, double leg,
+                            const Eigen::Vector2d& view);
 
 /// Fits the section at `origin` across `tangent`, taking the points of `cloud` within
 /// `slab` (m) of the plane through origin normal to the tangent and within `half_window` (m)

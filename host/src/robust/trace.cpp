@@ -17,6 +17,7 @@ GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
                          std::vector<std::uint32_t>& scratch, VFit mode) {
   const Eigen::Vector3d t = surface_tangent(ctx, origin, tangent, normal);
+  mode.corner_leg = ctx.params.fillet_leg;
   // The ball holds the window across, the slab along and the groove's depth below.
   const double radius = 1.3 * ctx.half_window + slab;
   ctx.bins.within_slab(ctx.cloud, origin, radius, t.normalized(), slab, scratch);

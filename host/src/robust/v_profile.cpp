@@ -19,8 +19,8 @@
 #include "robust/vmodel.hpp"
 
 namespace groovetrace {
-namespace {
 
+using robust_detail::fit_line;
 using robust_detail::fit_poly;
 using robust_detail::kLeftU;
 using robust_detail::kQ0;
@@ -29,6 +29,7 @@ using robust_detail::kRightU;
 using robust_detail::kRootU;
 using robust_detail::kRootV;
 using robust_detail::nearest_piece;
+using robust_detail::robust_sigma;
 using robust_detail::top_at;
 using robust_detail::Vec6;
 using robust_detail::VModel;
@@ -36,7 +37,7 @@ using robust_detail::VModel;
 // Robust sigma of residuals: the rms of the smallest 80% of |r|, scaled to a Gaussian's sigma
 // (0.6616 sigma for a Gaussian). Unlike the MAD it does not collapse to zero on depths
 // quantized to 1 mm, where most of a flat's points share one value.
-double robust_sigma(const std::vector<double>& r) {
+double robust_detail::robust_sigma(const std::vector<double>& r) {
   if (r.empty()) return 0.0;
   std::vector<double> a(r.size());
   for (std::size_t k = 0; k < r.size(); ++k) a[k] = r[k] * r[k];
@@ -47,7 +48,34 @@ double robust_sigma(const std::vector<double>& r) {
   return std::sqrt(ss / keep) / 0.6616;
 }
 
-}  // namespace
+// Orthogonal (total least squares) line through `pts`, Tukey-reweighted on the perpendicular
+// residual: returns a point on it and its unit direction.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> robust_detail::fit_line(
+    const std::vector<Eigen::Vector2d>& pts, double scale) {
+  std::vector<double> w(pts.size(), 1.0);
+  Eigen::Vector2d c(0, 0), d(1, 0);
+  for (int iter = 0; iter < 5; ++iter) {
+    double sw = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      sw += w[k];
+      mean += w[k] * pts[k];
+    }
+    if (!(sw > 0)) break;
+    mean /= sw;
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      cov += w[k] * (pts[k] - mean) * (pts[k] - mean).transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    c = mean;
+    d = eig.eigenvectors().col(1).normalized();
+    const Eigen::Vector2d nrm(-d.y(), d.x());
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      w[k] = tukey_weight_or_one((pts[k] - c).dot(nrm), kTukeyC * scale);
+  }
+  return {c, d};
+}
 
 // Iteratively reweighted least squares, six rounds, each weighting by the last one's residuals.
 std::pair<Eigen::Vector3d, double> robust_detail::fit_poly(const std::vector<Eigen::Vector2d>& pts,
@@ -270,35 +298,6 @@ bool meet_top(const Eigen::Vector2d& from, const Eigen::Vector2d& dir, const Eig
   if (!(t > 0) || !std::isfinite(t)) return false;
   out = from + t * dir;
   return true;
-}
-
-// Orthogonal (total least squares) line through `pts`, Tukey-reweighted on the perpendicular
-// residual: returns a point on it and its unit direction.
-std::pair<Eigen::Vector2d, Eigen::Vector2d> fit_line(const std::vector<Eigen::Vector2d>& pts,
-                                                     double scale) {
-  std::vector<double> w(pts.size(), 1.0);
-  Eigen::Vector2d c(0, 0), d(1, 0);
-  for (int iter = 0; iter < 5; ++iter) {
-    double sw = 0;
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for (std::size_t k = 0; k < pts.size(); ++k) {
-      sw += w[k];
-      mean += w[k] * pts[k];
-    }
-    if (!(sw > 0)) break;
-    mean /= sw;
-    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-    for (std::size_t k = 0; k < pts.size(); ++k) {
-      cov += w[k] * (pts[k] - mean) * (pts[k] - mean).transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-    c = mean;
-    d = eig.eigenvectors().col(1).normalized();
-    const Eigen::Vector2d nrm(-d.y(), d.x());
-    for (std::size_t k = 0; k < pts.size(); ++k)
-      w[k] = tukey_weight_or_one((pts[k] - c).dot(nrm), kTukeyC * scale);
-  }
-  return {c, d};
 }
 
 struct PieceStats {
@@ -664,10 +663,9 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
   return alt;
 }
 
-}  // namespace
-
-VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
-                       const Eigen::Vector2d& view) {
+// The V model fitted (steps 1-6), `ok` or why not.
+VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
+               const Eigen::Vector2d& view) {
   VProfile out;
   ProfileFit f;
   f.W = half_window;
@@ -708,6 +706,17 @@ VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_wind
   const VProfile two_wall = judge_v(m, false, f);
   if (two_wall.ok) return two_wall;
   return one_wall_v(m, two_wall, f);
+}
+
+}  // namespace
+
+VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
+                       const Eigen::Vector2d& view) {
+  VProfile v = fit_v(all, half_window, mode, view);
+  if (v.ok) return v;
+  // No V: a corner between two faces (fillet, lap) has no top surface for it to stand on.
+  VProfile corner = fit_corner_profile(all, half_window, mode.corner_leg, view);
+  return corner.ok ? corner : v;
 }
 
 }  // namespace groovetrace

@@ -18,6 +18,15 @@ inline double top_at(const Eigen::Vector3d& q, double u) { return q[0] + q[1] * 
 /// the robust sigma of the final fit's residuals (m). Defined in v_profile.cpp.
 std::pair<Eigen::Vector3d, double> fit_poly(const std::vector<Eigen::Vector2d>& pts, int degree);
 
+/// Robust sigma of residuals `r` (m): the rms of the smallest 80 % of |r| scaled to a
+/// Gaussian's sigma (it does not collapse on depths quantized to 1 mm, as the MAD does).
+double robust_sigma(const std::vector<double>& r);
+
+/// Orthogonal (total least squares) line through profile points `pts` (m), Tukey-reweighted on
+/// the perpendicular residual at `scale` (m): a point on it and its unit direction.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> fit_line(const std::vector<Eigen::Vector2d>& pts,
+                                                     double scale);
+
 /// The V model: a top curve v = q0 + q1 u + q2 u^2 (q2 held in fits) on the left, the same
 /// raised by `step` on the right (plates set high-low; held in fits), a root vertex, and the
 /// two edges where the walls leave the tops at u_left < root.u < u_right (m).

@@ -234,6 +234,10 @@ void add_waypoint_specs(std::vector<ParamSpec>& s) {
                      "robust: arc length over which the torch's orientation turns through "
                      "corners; 0 = no blending",
                      robust(&RobustParams::orientation_blend), 0.0, 0.5));
+  s.push_back(length(kRobust, "fillet_leg",
+                     "robust: leg of the fillet weld on a corner joint (fillet, lap); it bounds "
+                     "the joint region",
+                     robust(&RobustParams::fillet_leg), 0.001, 0.05));
   s.push_back(integer(kPaper, "median_max_iterations", "geometric-median iteration cap",
                       paper(&PaperParams::median_max_iterations), 1, 1000000));
   s.push_back(length(kPaper, "median_tolerance", "geometric-median stop step",

@@ -1,0 +1,103 @@
+// The plane the workpiece stands on, and the corners that lie on it.
+//
+// A part standing on the table makes a concave corner with it all round its foot, and a plate
+// lying on the table is, in geometry, a lap joint: no cross-section tells them from a fillet or
+// lap weld. What does is the table: a large plane with nothing seen behind it, and the corners
+// along it are the parts' feet, not joints.
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "robust/context.hpp"
+
+namespace groovetrace::robust_detail {
+namespace {
+
+// A plane is large when this share of the map's voxels lies within kPlaneTolerance of it.
+constexpr double kLargeShare = 0.15;
+constexpr double kPlaneTolerance = 0.002;  // m
+constexpr double kBehindShare = 0.02;
+// Planes tried: through this many voxels spread evenly over the map, each with its normal.
+constexpr std::size_t kTries = 256;
+
+// The plane fitted (principal axes) to the voxels within kPlaneTolerance of `plane`, twice: a
+// plane through one voxel takes that voxel's normal, a degree or two off the table's, which
+// puts it millimetres off the table 100 mm away; the table's own points put it back.
+SupportPlane refit(const CreaseMap& map, SupportPlane plane) {
+  for (int round = 0; round < 2; ++round) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    std::size_t n = 0;
+    for (const Eigen::Vector3f& qf : map.points) {
+      const Eigen::Vector3d q = qf.cast<double>();
+      if (std::abs(plane.normal.dot(q - plane.point)) > kPlaneTolerance) continue;
+      mean += q;
+      cov += q * q.transpose();
+      ++n;
+    }
+    if (n < 3) return plane;
+    mean /= static_cast<double>(n);
+    cov = cov / static_cast<double>(n) - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    if (normal.dot(plane.normal) < 0) normal = -normal;
+    plane = SupportPlane{mean, normal};
+  }
+  return plane;
+}
+
+// Whether `plane` can be the table: it holds kLargeShare of the map's voxels within
+// kPlaneTolerance and has at most kBehindShare of them behind it (nothing is seen through a
+// table; a plane tilted across the table, or a plate's top above it, has table behind).
+bool table_like(const CreaseMap& map, const SupportPlane& plane) {
+  std::size_t on = 0, behind = 0;
+  for (const Eigen::Vector3f& q : map.points) {
+    const double h = plane.normal.dot(q.cast<double>() - plane.point);
+    on += std::abs(h) <= kPlaneTolerance;
+    behind += h < -3 * kPlaneTolerance;
+  }
+  const auto n = static_cast<double>(map.points.size());
+  return static_cast<double>(on) >= kLargeShare * n &&
+         static_cast<double>(behind) <= kBehindShare * n;
+}
+
+}  // namespace
+
+std::optional<SupportPlane> support_plane(const CreaseMap& map) {
+  const std::size_t n = map.points.size();
+  const Eigen::Vector3d eye = map.viewpoint.cast<double>();
+  std::optional<SupportPlane> best;
+  double best_distance = -INFINITY;
+  const std::size_t stride = std::max<std::size_t>(1, n / kTries);
+  for (std::size_t k = 0; k < n; k += stride) {
+    SupportPlane plane{map.points[k].cast<double>(), map.normals[k].cast<double>()};
+    if (!plane.point.allFinite() || !(plane.normal.norm() > 0.5)) continue;
+    if (!table_like(map, plane)) continue;
+    plane = refit(map, plane);
+    const double distance = std::abs(plane.normal.dot(eye - plane.point));
+    if (table_like(map, plane) && distance > best_distance) {
+      best_distance = distance;
+      best = plane;
+    }
+  }
+  return best;
+}
+
+void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& seams) {
+  for (SeamCandidate& seam : seams) {
+    if (!seam.accepted || (seam.joint != "fillet" && seam.joint != "lap")) continue;
+    std::size_t on = 0, ok = 0;
+    for (const GrooveSection& s : seam.sections) {
+      if (!s.ok) continue;
+      ++ok;
+      on += std::abs(plane.normal.dot(s.root - plane.point)) <= kFootHeight;
+    }
+    if (2 * on > ok) {
+      seam.accepted = false;
+      seam.reason = "a corner along the table (the farthest large plane): a part's foot";
+    }
+  }
+}
+
+}  // namespace groovetrace::robust_detail
