@@ -42,9 +42,10 @@ std::string joint_kind(const std::vector<GrooveSection>& secs) {
   return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";
 }
 
-// Clamps and blocks standing on a part make corners 20-40 mm long that a cross-section cannot
-// tell from a fillet; a corner joint must be longer than that.
-constexpr double kMinCornerLength = 0.04;
+// Clamps and blocks standing on a part make corners along their feet that no cross-section
+// tells from a fillet: a clamp's 30 x 20 mm foot seen on two sides gives 50 mm. A corner joint
+// must be longer than that (a limit: shorter fillets are not reported).
+constexpr double kMinCornerLength = 0.06;
 
 // Median |high-low| of the two-wall sections' top sides (m); 0 with none.
 double median_misalignment(const std::vector<GrooveSection>& secs) {
