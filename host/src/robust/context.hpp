@@ -76,7 +76,7 @@ struct SupportPlane {
 
 /// The table the workpiece stands on, if seen: of the planes through the voxels of `map` (each
 /// with its own normal, refitted to the voxels within 2 mm) that hold at least 15 % of them and
-/// have at most 2 % behind them, the farthest from the viewpoint.
+/// have at most 2 % behind them, the one holding the most.
 std::optional<SupportPlane> support_plane(const CreaseMap& map);
 
 /// Corner roots this near the support plane (m) are a part's foot on the table.

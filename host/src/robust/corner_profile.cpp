@@ -46,9 +46,16 @@ bool intersect(const Eigen::Vector2d& a, const Eigen::Vector2d& da, const Eigen:
   return out.allFinite();
 }
 
-// Fits a line to `face.pts` at Tukey `scale` (m) and points it away from `root`.
-void fit_face(Face& face, const Eigen::Vector2d& root, double scale, Eigen::Vector2d& on_line) {
-  const auto [c, d] = fit_line(face.pts, scale);
+// Fits a line to `face.pts` at Tukey `scale` (m) and points it away from `root`. Once the face
+// has an extent, the points within `zone` (m) of its far end stay out: a lap's upper plate edge
+// is rounded off there as a V's rims are, and the upper plate's top begins.
+void fit_face(Face& face, const Eigen::Vector2d& root, double scale, double zone,
+              Eigen::Vector2d& on_line) {
+  std::vector<Eigen::Vector2d> used;
+  for (const auto& p : face.pts) {
+    if (!(face.extent > 0) || (p - root).dot(face.dir) <= face.extent - zone) used.push_back(p);
+  }
+  const auto [c, d] = fit_line(used.size() >= 8 ? used : face.pts, scale);
   on_line = c;
   face.dir = (c - root).dot(d) >= 0 ? d : Eigen::Vector2d(-d);
 }
@@ -77,11 +84,11 @@ bool refit_corner(const std::vector<Eigen::Vector2d>& pts, Corner& c, double zon
   }
   if (c.left.pts.size() < 8 || c.right.pts.size() < 8) return false;
   Eigen::Vector2d on_l, on_r;
-  fit_face(c.left, c.root, scale, on_l);
-  fit_face(c.right, c.root, scale, on_r);
+  fit_face(c.left, c.root, scale, zone, on_l);
+  fit_face(c.right, c.root, scale, zone, on_r);
   if (!intersect(on_l, c.left.dir, on_r, c.right.dir, c.root)) return false;
-  fit_face(c.left, c.root, scale, on_l);  // re-orient away from the new root
-  fit_face(c.right, c.root, scale, on_r);
+  fit_face(c.left, c.root, scale, zone, on_l);  // re-orient away from the new root
+  fit_face(c.right, c.root, scale, zone, on_r);
   return true;
 }
 
@@ -119,7 +126,7 @@ int upper_plate_points(const Corner& c, double scale) {
       if ((p - c.root).dot(edge.dir) > 0.5 * edge.extent) off.push_back(p);
     }
   }
-  if (off.size() < 8) return 0;
+  if (off.size() < 5) return 0;
   const auto [on, dir] = fit_line(off, scale);
   if (std::abs(dir.dot(lower.dir)) < std::cos(deg_to_rad(15))) return 0;
   const Eigen::Vector2d n(-dir.y(), dir.x());

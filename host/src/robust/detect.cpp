@@ -28,8 +28,8 @@ void per_point_fields(const Cloud& cloud, const CreaseMap& map, RobustDetection&
 }
 
 // The nodes whose V fit across their own direction passed (a thicker slab: one fit only) with
-// a width (m) in the band [lo, hi) this scale reads: each fit's root (m), tangent and top
-// normal.
+// a width (m) in the band [lo, hi) this scale reads, and the corners (fillet, lap): each fit's
+// root (m), tangent and top normal.
 struct ConfirmedNodes {
   std::vector<Eigen::Vector3d> roots, tangents, normals;
 };
@@ -51,7 +51,8 @@ ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes, doubl
   }
   ConfirmedNodes out;
   for (const GrooveSection& c : checks) {
-    if (!c.ok || c.width < lo || c.width >= hi) continue;
+    // A corner's width is its weld's (the legs'), not a measure of the scale it fits.
+    if (!c.ok || (!c.corner && (c.width < lo || c.width >= hi))) continue;
     out.roots.push_back(c.root);
     out.tangents.push_back(c.tangent);
     out.normals.push_back(c.normal);

@@ -25,7 +25,9 @@ double relative_spread(const std::vector<double>& v) {
 // or a hidden side whose mirror image would have been seen) and the other at least 20 deg
 // flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
 // A corner (no top across it) is a fillet, or a lap where one face, the upper plate's edge,
-// ends inside the window: each by the majority of the sections that passed.
+// ends inside the window and the upper plate's top follows: when the majority of the sections
+// that passed are corners, and a third of those see the upper plate (its top holds only a few
+// points of a narrow window, so not every section sees it).
 std::string joint_kind(const std::vector<GrooveSection>& secs) {
   std::vector<double> steep, flat;
   std::size_t corners = 0, short_faces = 0;
@@ -36,7 +38,7 @@ std::string joint_kind(const std::vector<GrooveSection>& secs) {
     steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
     flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
   }
-  if (2 * corners > steep.size()) return 2 * short_faces > corners ? "lap" : "fillet";
+  if (2 * corners > steep.size()) return 3 * short_faces >= corners ? "lap" : "fillet";
   if (steep.size() < 3) return "V";
   const double hi = upper_median(steep), lo = upper_median(flat);
   return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";

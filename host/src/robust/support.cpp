@@ -2,8 +2,8 @@
 //
 // A part standing on the table makes a concave corner with it all round its foot, and a plate
 // lying on the table is, in geometry, a lap joint: no cross-section tells them from a fillet or
-// lap weld. What does is the table: a large plane with nothing seen behind it, and the corners
-// along it are the parts' feet, not joints.
+// lap weld. What does is the table: a large plane with nothing seen behind it (the one holding
+// the most voxels, if several), and the corners along it are the parts' feet, not joints.
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -47,10 +47,10 @@ SupportPlane refit(const CreaseMap& map, SupportPlane plane) {
   return plane;
 }
 
-// Whether `plane` can be the table: it holds kLargeShare of the map's voxels within
-// kPlaneTolerance and has at most kBehindShare of them behind it (nothing is seen through a
-// table; a plane tilted across the table, or a plate's top above it, has table behind).
-bool table_like(const CreaseMap& map, const SupportPlane& plane) {
+// How many of the map's voxels `plane` holds within kPlaneTolerance when it can be the table:
+// that is at least kLargeShare of them, with at most kBehindShare behind it (nothing is seen
+// through a table; a plate's top above it has the table behind). 0 when it cannot.
+std::size_t table_support(const CreaseMap& map, const SupportPlane& plane) {
   std::size_t on = 0, behind = 0;
   for (const Eigen::Vector3f& q : map.points) {
     const double h = plane.normal.dot(q.cast<double>() - plane.point);
@@ -58,26 +58,26 @@ bool table_like(const CreaseMap& map, const SupportPlane& plane) {
     behind += h < -3 * kPlaneTolerance;
   }
   const auto n = static_cast<double>(map.points.size());
-  return static_cast<double>(on) >= kLargeShare * n &&
-         static_cast<double>(behind) <= kBehindShare * n;
+  const bool table =
+      static_cast<double>(on) >= kLargeShare * n && static_cast<double>(behind) <= kBehindShare * n;
+  return table ? on : 0;
 }
 
 }  // namespace
 
 std::optional<SupportPlane> support_plane(const CreaseMap& map) {
   const std::size_t n = map.points.size();
-  const Eigen::Vector3d eye = map.viewpoint.cast<double>();
   std::optional<SupportPlane> best;
-  double best_distance = -INFINITY;
+  std::size_t best_support = 0;
   const std::size_t stride = std::max<std::size_t>(1, n / kTries);
   for (std::size_t k = 0; k < n; k += stride) {
     SupportPlane plane{map.points[k].cast<double>(), map.normals[k].cast<double>()};
     if (!plane.point.allFinite() || !(plane.normal.norm() > 0.5)) continue;
-    if (!table_like(map, plane)) continue;
+    if (table_support(map, plane) == 0) continue;
     plane = refit(map, plane);
-    const double distance = std::abs(plane.normal.dot(eye - plane.point));
-    if (table_like(map, plane) && distance > best_distance) {
-      best_distance = distance;
+    const std::size_t support = table_support(map, plane);
+    if (support > best_support) {
+      best_support = support;
       best = plane;
     }
   }
@@ -95,7 +95,8 @@ void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& se
     }
     if (2 * on > ok) {
       seam.accepted = false;
-      seam.reason = "a corner along the table (the farthest large plane): a part's foot";
+      seam.reason =
+          "a corner along the table (a large plane with nothing behind it): a part's foot";
     }
   }
 }
