@@ -173,6 +173,9 @@ TEST_F(BadInput, BadFlagValues) {
       {"--orientation-blend -0.01", "--orientation-blend"},
       {"--orientation-blend nan", "--orientation-blend"},
       {"--orientation-blend wide", "--orientation-blend"},
+      {"--fillet-leg 0", "--fillet-leg"},
+      {"--fillet-leg 0.2", "out of range"},
+      {"--fillet-leg leg", "--fillet-leg"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.flags);

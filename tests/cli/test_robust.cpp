@@ -2,6 +2,8 @@
 // --step / --slices / --max-seams, no groove -> exit 4, unorganized input, base frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <groovetrace/cloud_io.hpp>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -99,6 +101,37 @@ TEST_F(CliRobust, GrooveOnABoxWithReportedCandidates) {
   const Cloud annotated = read_cloud((out / "annotated.pcd").string());
   EXPECT_EQ(annotated.width, box.cloud.width);
   EXPECT_EQ(annotated.height, box.cloud.height);
+}
+
+// A fillet (T-joint) from the renderer: the joint type and the per-station corner geometry in
+// report.json, with the weld's leg as given (the scan cannot show it).
+TEST_F(CliRobust, FilletReportsItsJointAndTheWeldsLeg) {
+  const fs::path scan = dir_ / "fillet.pcd";
+  const auto s = test::run_cli(
+      "synth --shape straight --joint fillet --resolution 640x480 --seed 21 -o " + scan.string(),
+      dir_);
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  const fs::path out = dir_ / "out";
+  const auto r =
+      test::run_cli("run " + scan.string() + " --fillet-leg 0.006 -q -o " + out.string(), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["parameters"]["fillet_leg"].get<double>(), 0.006);
+  const auto& seam = report["robust"]["seams"].at(0);
+  EXPECT_EQ(seam["joint"], "fillet");
+  std::vector<double> angles;
+  for (const auto& st : seam["stations"]) {
+    if (st["fit"] != "corner") continue;
+    // The weld face between the legs' ends and its throat, for legs of 6 mm on a 90 deg corner.
+    EXPECT_NEAR(st["opening_m"].get<double>(), 0.006 * std::sqrt(2.0), 0.0015);
+    EXPECT_NEAR(st["depth_m"].get<double>(), 0.006 / std::sqrt(2.0), 0.0008);
+    angles.push_back(st["included_angle_deg"].get<double>());
+    EXPECT_NEAR(angles.back(), 90.0, 20.0);  // 74 deg at the first station, 87-97 elsewhere
+    EXPECT_TRUE(st["misalignment_m"].is_null());
+  }
+  ASSERT_GT(angles.size(), seam["stations"].size() / 2);
+  std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
+  EXPECT_NEAR(angles[angles.size() / 2], 90.0, 3.0);
 }
 
 TEST_F(CliRobust, StepSlicesAndMaxSeams) {

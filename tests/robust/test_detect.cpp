@@ -254,6 +254,42 @@ TEST(RobustDetect, SingleBevelIsReadAtACoarserScaleWhenTheBaseFails) {
   EXPECT_LT(angle, 1.5);    // 0.53 deg
 }
 
+// A fillet (T-joint: a web standing on a plate) seen down its bisector: no top surface across
+// the corner, so the V model alone found nothing (exit 4). The corner model reads it; the
+// table's corners along the plate's feet are not joints.
+TEST(RobustDetect, FilletIsFoundAtItsCornerOnItsBisector) {
+  SynthParams sp = vga_joint(21);
+  sp.joint = JointType::kFillet;
+  const SynthScan scan = render(sp);
+  const RobustParams p;
+  const RobustDetection d = detect_robust(scan.cloud, p);
+  ASSERT_GT(accepted_count(d), 0u);
+  EXPECT_EQ(accepted_count(d), 1u);
+  const SeamCandidate& s = *best_accepted(d);
+  EXPECT_EQ(s.joint, "fillet");
+  EXPECT_NEAR(s.opening_deg, 90, 5);
+  const auto [dist, angle] = path_errors(seam_trajectory(s, p), scan.truth.seams.at(0));
+  EXPECT_LT(dist, 0.0006);
+  EXPECT_LT(angle, 2.0);
+  EXPECT_GT(iou(d.groove, scan.truth.label, scan.cloud), 0.85);
+}
+
+// A lap joint: the upper plate's edge face is only a plate thick, then its top runs parallel
+// to the lower plate's; the lower plate's own edge on the table is the same corner in
+// geometry and must not be taken.
+TEST(RobustDetect, LapIsFoundAndThePlatesFootOnTheTableIsNot) {
+  SynthParams sp = vga_joint(22);
+  sp.joint = JointType::kLap;
+  const SynthScan scan = render(sp);
+  const RobustParams p;
+  const RobustDetection d = detect_robust(scan.cloud, p);
+  ASSERT_EQ(accepted_count(d), 1u);
+  const SeamCandidate& s = *best_accepted(d);
+  const auto [dist, angle] = path_errors(seam_trajectory(s, p), scan.truth.seams.at(0));
+  EXPECT_LT(dist, 0.0008);
+  EXPECT_LT(angle, 3.0);
+}
+
 // A 100 mm wide panel joint (150 deg): ten times the width the default scale's window holds;
 // the search at a larger scale finds it.
 TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {

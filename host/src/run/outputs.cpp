@@ -28,14 +28,18 @@ json stations_json(const SeamCandidate& seam) {
   auto num = finite_or_null;
   json out = json::array();
   for (const GrooveSection& s : seam.sections) {
-    const char* fit = s.ok ? (s.one_wall ? "one_wall" : "v") : s.inferred ? "inferred" : "none";
+    const char* fit = !s.ok        ? (s.inferred ? "inferred" : "none")
+                      : s.corner   ? "corner"
+                      : s.one_wall ? "one_wall"
+                                   : "v";
     out.push_back(
         {{"s_m", num(s.s)},
          {"root_m", {num(s.root.x()), num(s.root.y()), num(s.root.z())}},
          {"opening_m", num(s.width)},
          {"depth_m", num(s.depth)},
          {"included_angle_deg", s.ok ? num(s.opening_deg) : json(nullptr)},
-         {"misalignment_m", s.ok && !s.one_wall ? num(std::abs(s.misalignment)) : json(nullptr)},
+         {"misalignment_m",
+          s.ok && !s.one_wall && !s.corner ? num(std::abs(s.misalignment)) : json(nullptr)},
          {"fit", fit}});
   }
   return out;
