@@ -82,7 +82,8 @@ struct SeamCandidate {
   double misalignment = 0.0;  ///< median |high-low| of the tops over the ok sections (m)
   double scale = 0.0;         ///< the search scale it was found at (m; RobustParams::scales)
   bool accepted = false;
-  std::string reason;  ///< why rejected (empty when accepted)
+  std::string reason;   ///< why rejected (empty when accepted)
+  bool corner = false;  ///< traced as a corner joint (fillet, lap), not a groove (V, bevel)
 };
 
 /// Torch poses along a seam: positions on the smoothed root line (its height along the top

@@ -46,8 +46,9 @@ GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
 
 /// Traces one seam along its ordered node roots (m) with their surface normals: sections
 /// fitted at stations along it, twice, smoothed along it, and its ends extended and trimmed.
+/// `corner`: the nodes are a corner joint's (fillet, lap), fitted with the corner model only.
 SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordered,
-                         std::vector<Eigen::Vector3d> normals, bool closed);
+                         std::vector<Eigen::Vector3d> normals, bool closed, bool corner);
 
 // --- section_smoothing.cpp ------------------------------------------------------------------
 

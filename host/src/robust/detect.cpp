@@ -32,9 +32,21 @@ void per_point_fields(const Cloud& cloud, const CreaseMap& map, RobustDetection&
 // root (m), tangent and top normal.
 struct ConfirmedNodes {
   std::vector<Eigen::Vector3d> roots, tangents, normals;
+  void add(const GrooveSection& c) {
+    roots.push_back(c.root);
+    tangents.push_back(c.tangent);
+    normals.push_back(c.normal);
+  }
 };
 
-ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes, double lo, double hi) {
+// The confirmed nodes of each kind: grooves (V, bevel) and corners (fillet, lap). They are
+// traced apart: a chain through both kinds (a pipe's V running into the corner along its foot)
+// is no one joint.
+struct ConfirmedKinds {
+  ConfirmedNodes grooves, corners;
+};
+
+ConfirmedKinds confirm_nodes(const Context& ctx, const CreaseNodes& nodes, double lo, double hi) {
   const std::size_t nn = nodes.voxel.size();
   std::vector<GrooveSection> checks(nn);
   const std::int64_t count = static_cast<std::int64_t>(nn);
@@ -49,21 +61,23 @@ ConfirmedNodes confirm_nodes(const Context& ctx, const CreaseNodes& nodes, doubl
                                             scratch);
     }
   }
-  ConfirmedNodes out;
+  ConfirmedKinds out;
   for (const GrooveSection& c : checks) {
+    if (!c.ok) continue;
     // A corner's width is its weld's (the legs'), not a measure of the scale it fits.
-    if (!c.ok || (!c.corner && (c.width < lo || c.width >= hi))) continue;
-    out.roots.push_back(c.root);
-    out.tangents.push_back(c.tangent);
-    out.normals.push_back(c.normal);
+    if (c.corner) {
+      out.corners.add(c);
+    } else if (c.width >= lo && c.width < hi) {
+      out.grooves.add(c);
+    }
   }
   return out;
 }
 
 // Every path of confirmed nodes (linked within `link`, m) traced as a seam, then the seams
 // that are one merged.
-std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes& nodes,
-                                       double link) {
+std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes& nodes, double link,
+                                       bool corner) {
   const RobustParams& params = ctx.params;
   const auto min_nodes =
       static_cast<std::size_t>(std::max(5.0, params.min_length / params.cell / 3));
@@ -74,7 +88,7 @@ std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes&
       ordered.push_back(nodes.roots[v]);
       normals.push_back(nodes.normals[v]);
     }
-    seams.push_back(robust_detail::trace_seam(ctx, ordered, normals, path.closed));
+    seams.push_back(robust_detail::trace_seam(ctx, ordered, normals, path.closed, corner));
   }
   robust_detail::merge_seams(ctx, seams, link);
   return seams;
@@ -124,9 +138,11 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
                     NeighborGrid(voxel_cloud(search.map), static_cast<float>(params.scale)),
                     BoxBins(cloud, 0.25 * params.scale),
                     2 * params.scale};
-  const ConfirmedNodes confirmed = confirm_nodes(ctx, search.nodes, search.lo, search.hi);
-  search.summary.confirmed_nodes = confirmed.roots.size();
-  search.seams = trace_seams(ctx, confirmed, 1.5 * params.scale);
+  const ConfirmedKinds confirmed = confirm_nodes(ctx, search.nodes, search.lo, search.hi);
+  search.summary.confirmed_nodes = confirmed.grooves.roots.size() + confirmed.corners.roots.size();
+  search.seams = trace_seams(ctx, confirmed.grooves, 1.5 * params.scale, false);
+  for (SeamCandidate& seam : trace_seams(ctx, confirmed.corners, 1.5 * params.scale, true))
+    search.seams.push_back(std::move(seam));
   for (SeamCandidate& seam : search.seams) {
     score_seam(seam, params);
     seam.scale = params.scale;

@@ -140,7 +140,7 @@ bool join_seams(const Context& ctx, const SeamCandidate& a, const SeamCandidate&
   if (!join) return false;
   std::vector<Eigen::Vector3d> ordered, normals;
   joined_nodes(a, b, rest, end_a, end_b, ordered, normals);
-  joined = trace_seam(ctx, ordered, normals, false);
+  joined = trace_seam(ctx, ordered, normals, false, a.corner);
   return joined.sections.size() >= 2;
 }
 

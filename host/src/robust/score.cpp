@@ -24,21 +24,19 @@ double relative_spread(const std::vector<double>& v) {
 // A single bevel has one side square to the top (its dip over 75 deg: a wall measured steep
 // or a hidden side whose mirror image would have been seen) and the other at least 20 deg
 // flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
-// A corner (no top across it) is a fillet, or a lap where one face, the upper plate's edge,
-// ends inside the window and the upper plate's top follows: when the majority of the sections
-// that passed are corners, and a third of those see the upper plate (its top holds only a few
-// points of a narrow window, so not every section sees it).
-std::string joint_kind(const std::vector<GrooveSection>& secs) {
+// A corner seam (no top across it) is a fillet, or a lap where one face, the upper plate's
+// edge, ends inside the window and the upper plate's top follows: when a third of its passing
+// sections see that top (it holds only a few points of a narrow window).
+std::string joint_kind(const SeamCandidate& seam) {
   std::vector<double> steep, flat;
-  std::size_t corners = 0, short_faces = 0;
-  for (const GrooveSection& s : secs) {
+  std::size_t short_faces = 0;
+  for (const GrooveSection& s : seam.sections) {
     if (!s.ok) continue;
-    corners += s.corner;
-    short_faces += s.corner && s.short_face;
+    short_faces += s.short_face;
     steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
     flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
   }
-  if (2 * corners > steep.size()) return 3 * short_faces >= corners ? "lap" : "fillet";
+  if (seam.corner) return 3 * short_faces >= steep.size() && short_faces > 0 ? "lap" : "fillet";
   if (steep.size() < 3) return "V";
   const double hi = upper_median(steep), lo = upper_median(flat);
   return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";
@@ -80,7 +78,7 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
   seam.consistency =
       width.empty() ? 0.0 : std::max(0.0, 1.0 - relative_spread(width) - relative_spread(opening));
   seam.score = seam.length * 1000.0 * seam.ok_fraction * seam.fit_quality * seam.consistency;
-  seam.joint = joint_kind(seam.sections);
+  seam.joint = joint_kind(seam);
   seam.misalignment = median_misalignment(seam.sections);
 
   seam.accepted = false;
@@ -88,7 +86,7 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
     seam.reason = "fewer than 3 V-shaped sections";
   } else if (seam.length < params.min_length) {
     seam.reason = "shorter than min_length";
-  } else if ((seam.joint == "fillet" || seam.joint == "lap") && seam.length < kMinCornerLength) {
+  } else if (seam.corner && seam.length < kMinCornerLength) {
     seam.reason = "a corner shorter than a fixture's (clamp, block)";
   } else if (seam.ok_fraction < 0.4) {
     seam.reason = "fewer than 40 % of the sections are V-shaped";

@@ -97,6 +97,10 @@ struct VFit {
   /// The weld's leg on a corner joint (fillet or lap), m: where the V fails, a concave corner
   /// is fitted instead and its opening is the weld face between the legs' ends.
   double corner_leg = 0.007;
+  /// Which models are fitted: a V and, where it fails, a corner (`any`: a node not yet on a
+  /// seam), or only the kind of the seam being traced.
+  enum class Kind { any, groove, corner };
+  Kind kind = Kind::any;
 };
 
 /// Fits a V-groove to profile points within |u| <= half_window: the top surface as a robust

@@ -86,7 +86,7 @@ std::optional<SupportPlane> support_plane(const CreaseMap& map) {
 
 void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& seams) {
   for (SeamCandidate& seam : seams) {
-    if (!seam.accepted || (seam.joint != "fillet" && seam.joint != "lap")) continue;
+    if (!seam.accepted || !seam.corner) continue;
     std::size_t on = 0, ok = 0;
     for (const GrooveSection& s : seam.sections) {
       if (!s.ok) continue;

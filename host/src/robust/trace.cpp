@@ -103,7 +103,8 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
   }
   const OkMedians med = ok_medians(secs);
   std::vector<std::uint32_t> scratch;
-  for (std::size_t k = 0; k < m && med.count >= 3; ++k) {
+  const bool gaps = mode.kind != VFit::Kind::corner;  // a corner has no top to hold a gap
+  for (std::size_t k = 0; k < m && gaps && med.count >= 3; ++k) {
     if (secs[k].ok) continue;
     const Eigen::Vector3d n = secs[k].normal.allFinite() ? secs[k].normal : hint_normals[0];
     GrooveSection g = gap_section_at(ctx, curve.points[k], curve.tangents[k], n, med, scratch);
@@ -178,10 +179,11 @@ bool off_track(const Context& ctx, const GrooveSection& sec, const Eigen::Vector
 // The section tracked at `at` across `tangent` (`normal`: the seam's last section's): a V, or
 // where none fits a gap of the seam's width seen at a slant; neither when off the track.
 GrooveSection section_ahead(const Context& ctx, const OkMedians& med, const Eigen::Vector3d& at,
-                            const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal) {
+                            const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal,
+                            VFit mode) {
   std::vector<std::uint32_t> scratch;
-  GrooveSection sec = section_at(ctx, at, tangent, normal, ctx.params.slab, scratch);
-  if (!sec.ok) {
+  GrooveSection sec = section_at(ctx, at, tangent, normal, ctx.params.slab, scratch, mode);
+  if (!sec.ok && mode.kind != VFit::Kind::corner) {
     sec = gap_section_at(ctx, at, tangent, normal, med, scratch);
     if (sec.inferred && !grazing(ctx, sec.root, normal)) {
       sec.inferred = false;
@@ -197,7 +199,8 @@ GrooveSection section_ahead(const Context& ctx, const OkMedians& med, const Eige
 
 // Extends `secs` past its last section by tracking (see extend_ends): trailing stations whose
 // own fit failed are dropped first; misses are kept only if a later fit passes.
-void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSection>& secs) {
+void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSection>& secs,
+                 VFit mode) {
   const double reach = 10 * ctx.params.scale;  // at most 100 mm more per end
   while (!secs.empty() && !secs.back().ok && !secs.back().inferred) secs.pop_back();
   std::vector<GrooveSection> pending;
@@ -206,7 +209,7 @@ void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSec
     Eigen::Vector3d at, tangent;
     if (!continue_seam(ctx, secs, misses + 1, at, tangent)) break;
     const Eigen::Vector3d normal = secs.back().normal;
-    GrooveSection sec = section_ahead(ctx, med, at, tangent, normal);
+    GrooveSection sec = section_ahead(ctx, med, at, tangent, normal, mode);
     if (sec.ok || sec.inferred) {
       secs.insert(secs.end(), pending.begin(), pending.end());
       pending.clear();
@@ -227,12 +230,12 @@ void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSec
 // while fits pass (two misses in a row end it). The crease nodes stop short where the groove
 // is seen at a grazing angle (a pipe's flanks) yet a section across the expected place still
 // finds the V.
-void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs) {
+void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs, VFit mode) {
   const OkMedians med = ok_medians(secs);
   if (med.count == 0) return;
-  extend_back(ctx, med, secs);
+  extend_back(ctx, med, secs, mode);
   std::reverse(secs.begin(), secs.end());
-  extend_back(ctx, med, secs);
+  extend_back(ctx, med, secs, mode);
   std::reverse(secs.begin(), secs.end());
 }
 
@@ -406,8 +409,10 @@ void measure_along_roots(SeamCandidate& seam, bool closed) {
 }  // namespace
 
 SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordered,
-                         std::vector<Eigen::Vector3d> normals, bool closed) {
+                         std::vector<Eigen::Vector3d> normals, bool closed, bool corner) {
   SeamCandidate seam;
+  seam.corner = corner;
+  const VFit::Kind kind = corner ? VFit::Kind::corner : VFit::Kind::groove;
   const RobustParams& p = ctx.params;
   // A symmetric seam (the first pass's walls dip alike, within kSymmetricDeg) is fitted with
   // symmetric V's the second time: at a slant one wall is seen at a grazing angle, a pixel's
@@ -416,6 +421,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
   // flat, which moves its rim out and the root towards the other wall by up to a millimetre.
   // Plates set high-low are fitted with a step between the two tops the second time (VFit).
   VFit mode;
+  mode.kind = kind;
   for (int pass = 0; pass < 2; ++pass) {
     // Sampled finely, then at stations anchored to the frame (robust/stations.hpp).
     const SeamCurve curve = anchored_stations(
@@ -423,12 +429,15 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
     if (curve.points.size() < 2) break;
     std::vector<GrooveSection> raw = fit_stations(ctx, curve, ordered, normals, mode);
     reject_inconsistent(raw);
-    if (pass == 0) mode = seam_fit_mode(raw);
+    if (pass == 0) {
+      mode = seam_fit_mode(raw);
+      mode.kind = kind;
+    }
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);
     if (pass == 0 && !closed) {
-      extend_ends(ctx, smooth);
+      extend_ends(ctx, smooth, mode);
       if (smooth.size() < 2) break;
     }
     seam.curve = curve;

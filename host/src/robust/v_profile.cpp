@@ -712,8 +712,10 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
 
 VProfile fit_v_profile(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
                        const Eigen::Vector2d& view) {
+  if (mode.kind == VFit::Kind::corner)
+    return fit_corner_profile(all, half_window, mode.corner_leg, view);
   VProfile v = fit_v(all, half_window, mode, view);
-  if (v.ok) return v;
+  if (v.ok || mode.kind == VFit::Kind::groove) return v;
   // No V: a corner between two faces (fillet, lap) has no top surface for it to stand on.
   VProfile corner = fit_corner_profile(all, half_window, mode.corner_leg, view);
   return corner.ok ? corner : v;
