@@ -437,7 +437,9 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);
     if (pass == 0 && !closed) {
-      extend_ends(ctx, smooth, mode);
+      VFit ahead;  // the tracking fits as the first pass did: its own kind only
+      ahead.kind = kind;
+      extend_ends(ctx, smooth, ahead);
       if (smooth.size() < 2) break;
     }
     seam.curve = curve;
