@@ -48,6 +48,9 @@ struct GrooveSection {
   bool corner = false;
   /// With corner: one face ends inside the window, where the upper plate of a lap joint begins.
   bool short_face = false;
+  /// The V here reads shallower than the seam with its rims where the seam's are: something
+  /// fills the groove (a tack weld); not `ok`, so the root follows the neighbours.
+  bool filled = false;
   /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
   /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
   bool inferred = false;
@@ -77,8 +80,15 @@ struct SeamCandidate {
   double consistency = 0.0;  ///< 1 - relative spread of width and opening along the seam
   double width = 0, depth = 0, opening_deg = 0;  ///< medians (m, m, deg)
   double score = 0.0;  ///< length_mm * ok_fraction * fit_quality * consistency
-  /// "V", or "bevel" (one wall square to the top, the other inclined); docs/method-robust.md.
+  /// "V", "bevel" (one wall square to the top, the other inclined), "fillet" or "lap" (a
+  /// corner between two faces); docs/method-robust.md.
   std::string joint = "V";
+  /// Stretches where something fills the groove (tack welds): the arc length of each one's
+  /// centre along the seam and its length (m), in order along the seam.
+  struct Tack {
+    double position = 0.0, length = 0.0;
+  };
+  std::vector<Tack> tacks;
   double misalignment = 0.0;  ///< median |high-low| of the tops over the ok sections (m)
   double scale = 0.0;         ///< the search scale it was found at (m; RobustParams::scales)
   bool accepted = false;

@@ -64,23 +64,43 @@ void fit_face(Face& face, const Eigen::Vector2d& root, double scale, double zone
 struct Corner {
   Eigen::Vector2d root{0, 0};
   Face left, right;
-  double sigma = 0;  // robust sigma of the points' distances to their faces (m)
-  int upper = 0;     // points on a lap's upper plate (upper_plate_points)
+  double sigma = 0;     // robust sigma of the points' distances to their faces (m)
+  int upper = 0;        // points on a lap's upper plate (upper_plate_points)
+  std::size_t far = 0;  // points farther than the zone from the root
 };
 
-// One round: every point farther than `zone` from the root goes to the face it lies nearer
-// (the first round splits at u = root.u), both faces are refitted, the root moves to their
-// intersection. False when a face has too few points or the faces are near parallel.
+// Whether p, on the side of `face`, lies within its reach: up to two zones past its extent
+// (m; a face without an extent yet reaches everywhere). Past a lap's upper plate edge its
+// top begins, which is no part of the edge's face.
+bool within_reach(const Eigen::Vector2d& p, const Eigen::Vector2d& root, const Face& face,
+                  double zone) {
+  return !(face.extent > 0) || (p - root).dot(face.dir) <= face.extent + 2 * zone;
+}
+
+// One round: every point farther than `zone` from the root goes to the face it lies nearer -
+// if within 3 sigma (at least `zone`) of it and within its reach (the first round splits at u =
+// root.u and takes the points within `start` of the root: a lap's upper plate top, more points than
+// its edge face in a wide window, must not be taken for that face), both faces are refitted, the
+// root moves to their intersection. False when a face has too few points or the faces are near
+// parallel.
 bool refit_corner(const std::vector<Eigen::Vector2d>& pts, Corner& c, double zone, double scale,
-                  bool first) {
+                  bool first, double start) {
   c.left.pts.clear();
   c.right.pts.clear();
+  c.far = 0;
   for (const auto& p : pts) {
-    if ((p - c.root).norm() < zone) continue;
-    const bool left =
-        first ? p.x() < c.root.x()
-              : ray_distance(p, c.root, c.left.dir) < ray_distance(p, c.root, c.right.dir);
-    (left ? c.left : c.right).pts.push_back(p);
+    const double r = (p - c.root).norm();
+    if (r < zone) continue;
+    ++c.far;
+    if (first) {
+      if (r <= start) (p.x() < c.root.x() ? c.left : c.right).pts.push_back(p);
+      continue;
+    }
+    const double dl = ray_distance(p, c.root, c.left.dir);
+    const double dr = ray_distance(p, c.root, c.right.dir);
+    Face& face = dl < dr ? c.left : c.right;
+    if (std::min(dl, dr) <= std::max(3 * c.sigma, zone) && within_reach(p, c.root, face, zone))
+      face.pts.push_back(p);
   }
   if (c.left.pts.size() < 8 || c.right.pts.size() < 8) return false;
   Eigen::Vector2d on_l, on_r;
@@ -92,20 +112,29 @@ bool refit_corner(const std::vector<Eigen::Vector2d>& pts, Corner& c, double zon
   return true;
 }
 
-// Each face's inliers and extent, and the corner's sigma.
-void measure_corner(Corner& c) {
+// The corner's sigma (from its faces' points), and each face's run: of all points `pts` within
+// 3 sigma of the face (none within `zone` of the root), those in an unbroken run from the root
+// (no gap over `gap`, m) - its inliers and its extent, where the face ends (a lap's upper plate
+// edge) or leaves the window.
+void measure_corner(const std::vector<Eigen::Vector2d>& pts, Corner& c, double zone, double gap) {
   std::vector<double> r;
   for (Face* f : {&c.left, &c.right}) {
     for (const auto& p : f->pts) r.push_back(ray_distance(p, c.root, f->dir));
   }
   c.sigma = robust_sigma(r);
   for (Face* f : {&c.left, &c.right}) {
+    std::vector<double> along;
+    for (const auto& p : pts) {
+      if ((p - c.root).norm() >= zone && ray_distance(p, c.root, f->dir) <= 3 * c.sigma)
+        along.push_back((p - c.root).dot(f->dir));
+    }
+    std::sort(along.begin(), along.end());
     f->inliers = 0;
     f->extent = 0;
-    for (const auto& p : f->pts) {
-      if (ray_distance(p, c.root, f->dir) > 3 * c.sigma) continue;
+    for (double t : along) {
+      if (t > f->extent + gap && f->inliers > 0) break;
       ++f->inliers;
-      f->extent = std::max(f->extent, (p - c.root).dot(f->dir));
+      f->extent = t;
     }
   }
 }
@@ -113,18 +142,16 @@ void measure_corner(Corner& c) {
 // A lap's upper plate: beyond the end of the shorter face (the upper plate's edge), points off
 // both faces that lie on a line parallel to the longer face (the upper plate's top, a plate
 // thickness above the lower one's). How many points that line holds; 0 when it is not there.
-int upper_plate_points(const Corner& c, double scale) {
+int upper_plate_points(const std::vector<Eigen::Vector2d>& pts, const Corner& c, double scale) {
   const bool left_short = c.left.extent < c.right.extent;
   const Face& edge = left_short ? c.left : c.right;
   const Face& lower = left_short ? c.right : c.left;
   const double tol = 3 * c.sigma;
   std::vector<Eigen::Vector2d> off;
-  for (const Face* f : {&c.left, &c.right}) {
-    for (const auto& p : f->pts) {
-      if (ray_distance(p, c.root, c.left.dir) <= tol || ray_distance(p, c.root, c.right.dir) <= tol)
-        continue;
-      if ((p - c.root).dot(edge.dir) > 0.5 * edge.extent) off.push_back(p);
-    }
+  for (const auto& p : pts) {
+    if (ray_distance(p, c.root, c.left.dir) <= tol || ray_distance(p, c.root, c.right.dir) <= tol)
+      continue;
+    if ((p - c.root).dot(edge.dir) > 0.5 * edge.extent) off.push_back(p);
   }
   if (off.size() < 5) return 0;
   const auto [on, dir] = fit_line(off, scale);
@@ -147,8 +174,7 @@ const char* why_not_corner(const Corner& c, double W, double leg, const Eigen::V
   if (std::abs(c.root.x()) > 0.5 * W) return "corner: root leaves the window";
   if (c.sigma > 0.08 * W) return "corner: faces are not straight";
   if (c.left.extent < leg || c.right.extent < leg) return "corner: a face is shorter than the leg";
-  const double total = static_cast<double>(c.left.pts.size() + c.right.pts.size());
-  if (c.left.inliers + c.right.inliers + c.upper < 0.8 * total) {
+  if (c.left.inliers + c.right.inliers + c.upper < 0.8 * static_cast<double>(c.far)) {
     return "corner: points off both faces";
   }
   return nullptr;
@@ -200,14 +226,14 @@ VProfile fit_corner_profile(const std::vector<Eigen::Vector2d>& uv, double half_
   const double zone = 0.1 * W;
   double scale = 0.05 * W;
   for (int round = 0; round < 4; ++round) {
-    if (!refit_corner(pts, c, zone, scale, round == 0)) {
+    if (!refit_corner(pts, c, zone, scale, round == 0, 0.5 * W)) {
       out.why = "corner: no two faces";
       return out;
     }
-    measure_corner(c);
+    measure_corner(pts, c, zone, 0.15 * W);
     scale = std::max(c.sigma, 0.005 * W);
   }
-  c.upper = upper_plate_points(c, scale);
+  c.upper = upper_plate_points(pts, c, scale);
   if (const char* why = why_not_corner(c, W, leg, view.normalized())) {
     out.why = why;
     return out;

@@ -243,13 +243,21 @@ void extend_ends(const Context& ctx, std::vector<GrooveSection>& secs, VFit mode
 // all its fits (narrower than 0.6 or wider than 1.6 times, shallower than 0.6 or deeper than
 // 1.5 times) caught something else - a shadow's edge, the table through a dropout - and is
 // not trusted.
+//
+// One kind of failure is a finding: shallower than 0.6 times the median depth with the seam's
+// width (its rims are where the seam's are), something fills the groove - a tack weld
+// (`filled`; reported, see find_tacks).
 void reject_inconsistent(std::vector<GrooveSection>& secs) {
   const OkMedians med = ok_medians(secs);
   if (med.count < 5) return;
   for (auto& s : secs) {
     if (!s.ok) continue;
-    if (s.width < 0.6 * med.width || s.width > 1.6 * med.width || s.depth < 0.6 * med.depth ||
-        s.depth > 1.5 * med.depth) {
+    const bool wide_as_seam = s.width >= 0.6 * med.width && s.width <= 1.6 * med.width;
+    if (wide_as_seam && s.depth < 0.6 * med.depth && !s.corner) {
+      s.ok = false;
+      s.filled = true;
+      s.why = "filled: shallower than the seam (a tack weld)";
+    } else if (!wide_as_seam || s.depth < 0.6 * med.depth || s.depth > 1.5 * med.depth) {
       s.ok = false;
       s.why = "inconsistent with the seam";
     }
@@ -382,7 +390,7 @@ void trim_ends(SeamCandidate& seam, double link) {
 }
 
 // The seam's length, arc lengths and corners measured along its smoothed roots (for the score
-// and the region): each corner moves to the station nearest its old arc length.
+// and the region): each corner and tack moves to the station nearest its old arc length.
 void measure_along_roots(SeamCandidate& seam, bool closed) {
   std::vector<double> old_s, new_s;
   double s = 0;
@@ -393,17 +401,46 @@ void measure_along_roots(SeamCandidate& seam, bool closed) {
     seam.sections[k].s = s;
   }
   if (closed) s += (seam.sections.front().root - seam.sections.back().root).norm();
-  std::vector<double> corners;
-  for (double c : seam.curve.corners) {
+  auto moved = [&](double c) {
     std::size_t best = 0;
     for (std::size_t k = 0; k < old_s.size(); ++k) {
       if (std::abs(old_s[k] - c) < std::abs(old_s[best] - c)) best = k;
     }
-    corners.push_back(new_s[best]);
-  }
-  seam.curve.corners = corners;
+    return new_s[best];
+  };
+  for (double& c : seam.curve.corners) c = moved(c);
+  for (SeamCandidate::Tack& t : seam.tacks) t.position = moved(t.position);
   seam.curve.length = s;
   seam.curve.closed = closed;
+}
+
+// The tack welds along a seam: runs of at least three `filled` stations of `raw` (one station
+// that is neither filled nor ok may sit inside a run), each as its centre's arc length and its
+// length (m, one `station` more than its first to last station).
+std::vector<SeamCandidate::Tack> find_tacks(const std::vector<GrooveSection>& raw, double station) {
+  std::vector<SeamCandidate::Tack> tacks;
+  std::size_t k = 0;
+  while (k < raw.size()) {
+    if (!raw[k].filled) {
+      ++k;
+      continue;
+    }
+    std::size_t last = k, count = 1;
+    for (std::size_t j = k + 1; j < raw.size(); ++j) {
+      if (raw[j].filled) {
+        last = j;
+        ++count;
+      } else if (raw[j].ok || j > last + 1) {
+        break;
+      }
+    }
+    if (count >= 3) {
+      const double from = raw[k].s, to = raw[last].s;
+      tacks.push_back({0.5 * (from + to), to - from + station});
+    }
+    k = last + 1;
+  }
+  return tacks;
 }
 
 }  // namespace
@@ -456,6 +493,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
     }
   }
   if (!closed) trim_ends(seam, 1.5 * p.scale);
+  seam.tacks = find_tacks(seam.raw, p.station);
   if (seam.sections.size() >= 2) measure_along_roots(seam, closed);
   seam.closed = closed;
   return seam;

@@ -45,6 +45,15 @@ json stations_json(const SeamCandidate& seam) {
   return out;
 }
 
+// The tack welds found along a seam: arc length of each one's centre and its length (m).
+json tacks_json(const SeamCandidate& seam) {
+  json out = json::array();
+  for (const SeamCandidate::Tack& t : seam.tacks)
+    out.push_back(
+        {{"position_m", finite_or_null(t.position)}, {"length_m", finite_or_null(t.length)}});
+  return out;
+}
+
 // The fastest turn of the torch along `t` (deg/mm) and where (arc length, m); null without a
 // trajectory.
 void add_rotation_rate(json& j, const Trajectory* t) {
@@ -72,6 +81,7 @@ json seam_json(const SeamCandidate& s, std::size_t rank, const json& file, const
             {"joint", s.joint},
             {"misalignment_m", num(s.misalignment)},
             {"scale_m", num(s.scale)},
+            {"tacks", tacks_json(s)},
             {"file", file}};
   if (!file.is_null()) j["stations"] = stations_json(s);
   add_rotation_rate(j, t);
