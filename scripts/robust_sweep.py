@@ -1058,7 +1058,7 @@ def joint_header(args, records):
         "0 % and coverage 0 %; its lateral, depth and tool axis are left out (no trajectory). "
         "found = exit 0: the exported seam may still be another one than the joint (IoU near 0, "
         "errors of centimetres: see every scan). "
-        "The detector reports only `V` or `bevel`, so fillet and lap cannot match.", ""]
+        "The detector reports `V`, `bevel`, `fillet` or `lap` per seam.", ""]
 
 
 def write_joint_results(args, records):
