@@ -24,8 +24,8 @@ using robust_detail::robust_sigma;
 struct Face {
   Eigen::Vector2d dir{0, 1};         // unit, from the root along the face
   std::vector<Eigen::Vector2d> pts;  // the points nearest to this face, off the root
-  int inliers = 0;                   // within 3 sigma of the face
-  double extent = 0;                 // farthest inlier from the root along dir (m)
+  int inliers = 0;                   // points of its unbroken run (measure_corner)
+  double extent = 0;                 // where that run ends, from the root along dir (m)
 };
 
 // Distance (m) from p to the ray from `root` along `dir`.
