@@ -216,6 +216,17 @@ SynthParams vga_joint(std::uint64_t seed) {
   return sp;
 }
 
+// A joint rendered from `sp` and the default robust run on it.
+struct JointRun {
+  explicit JointRun(const SynthParams& sp) : scan(render(sp)), det(detect_robust(scan.cloud, {})) {}
+  // path_errors of `seam`'s trajectory against the first true seam.
+  std::pair<double, double> errors(const SeamCandidate& seam) const {
+    return path_errors(seam_trajectory(seam, RobustParams{}), scan.truth.seams.at(0));
+  }
+  SynthScan scan;
+  RobustDetection det;
+};
+
 // A single bevel (45 deg, 8 mm deep) seen from above: its square side returns nothing. Read
 // as a symmetric V, the path ran halfway up the inclined wall (3.7 mm across and 3.5 mm above
 // the root) with the torch 22.5 deg off the joint's bisector.
@@ -224,13 +235,11 @@ TEST(RobustDetect, SingleBevelIsFoundAtTheFootOfItsSquareSide) {
   sp.joint = JointType::kBevel;
   sp.groove_angle_deg = 45;
   sp.groove_width = 0.0085;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_GT(accepted_count(d), 0u);
   EXPECT_EQ(best_accepted(d)->joint, "bevel");
-  const auto [dist, angle] =
-      path_errors(seam_trajectory(*best_accepted(d), p), scan.truth.seams.at(0));
+  const auto [dist, angle] = run.errors(*best_accepted(d));
   EXPECT_LT(dist, 0.0012);
   EXPECT_LT(angle, 4.0);  // 3.1 deg here at 640x480; the issue asks 2 deg on the sweep (not met)
 }
@@ -243,13 +252,11 @@ TEST(RobustDetect, SingleBevelIsReadAtACoarserScaleWhenTheBaseFails) {
   sp.joint = JointType::kBevel;
   sp.groove_angle_deg = 45;
   sp.groove_width = 0.0085;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_GT(accepted_count(d), 0u);
   EXPECT_EQ(best_accepted(d)->joint, "bevel");
-  const auto [dist, angle] =
-      path_errors(seam_trajectory(*best_accepted(d), p), scan.truth.seams.at(0));
+  const auto [dist, angle] = run.errors(*best_accepted(d));
   EXPECT_LT(dist, 0.0014);  // 1.15 mm, of which 0.5 mm is the gap's depth convention
   EXPECT_LT(angle, 1.5);    // 0.53 deg
 }
@@ -260,18 +267,17 @@ TEST(RobustDetect, SingleBevelIsReadAtACoarserScaleWhenTheBaseFails) {
 TEST(RobustDetect, FilletIsFoundAtItsCornerOnItsBisector) {
   SynthParams sp = vga_joint(21);
   sp.joint = JointType::kFillet;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_GT(accepted_count(d), 0u);
   EXPECT_EQ(accepted_count(d), 1u);
   const SeamCandidate& s = *best_accepted(d);
   EXPECT_EQ(s.joint, "fillet");
   EXPECT_NEAR(s.opening_deg, 90, 5);
-  const auto [dist, angle] = path_errors(seam_trajectory(s, p), scan.truth.seams.at(0));
+  const auto [dist, angle] = run.errors(s);
   EXPECT_LT(dist, 0.0006);
   EXPECT_LT(angle, 2.0);
-  EXPECT_GT(iou(d.groove, scan.truth.label, scan.cloud), 0.85);
+  EXPECT_GT(iou(d.groove, run.scan.truth.label, run.scan.cloud), 0.85);
 }
 
 // A lap joint: the upper plate's edge face is only a plate thick, then its top runs parallel
@@ -280,12 +286,11 @@ TEST(RobustDetect, FilletIsFoundAtItsCornerOnItsBisector) {
 TEST(RobustDetect, LapIsFoundAndThePlatesFootOnTheTableIsNot) {
   SynthParams sp = vga_joint(22);
   sp.joint = JointType::kLap;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_EQ(accepted_count(d), 1u);
   const SeamCandidate& s = *best_accepted(d);
-  const auto [dist, angle] = path_errors(seam_trajectory(s, p), scan.truth.seams.at(0));
+  const auto [dist, angle] = run.errors(s);
   EXPECT_LT(dist, 0.0008);
   EXPECT_LT(angle, 3.0);
 }
@@ -296,12 +301,11 @@ TEST(RobustDetect, TacksAreReportedAndThePathStaysOnTheRoot) {
   SynthParams sp;  // 1280x720: a 640x480 frame also reports 2-3 mm stretches of noise
   sp.seed = 23;
   sp.tacks = 3;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_GT(accepted_count(d), 0u);
   const SeamCandidate& s = *best_accepted(d);
-  const Seam& truth = scan.truth.seams.at(0);
+  const Seam& truth = run.scan.truth.seams.at(0);
   ASSERT_EQ(truth.tacks.size(), 3u);
   ASSERT_EQ(s.tacks.size(), 3u);
   // The seam may run either way along the truth's root line: compare each found tack's centre
@@ -321,7 +325,7 @@ TEST(RobustDetect, TacksAreReportedAndThePathStaysOnTheRoot) {
     EXPECT_LT(best, 0.005);
     EXPECT_NEAR(t.length, length, 0.006);
   }
-  EXPECT_LT(path_errors(seam_trajectory(s, p), truth).first, 0.0008);
+  EXPECT_LT(run.errors(s).first, 0.0008);
 }
 
 // A 100 mm wide panel joint (150 deg): ten times the width the default scale's window holds;
@@ -330,15 +334,14 @@ TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {
   SynthParams sp = vga_joint(12);
   sp.groove_width = 0.10;
   sp.groove_angle_deg = 150;
-  const SynthScan scan = render(sp);
-  const RobustParams p;
-  const RobustDetection d = detect_robust(scan.cloud, p);
+  const JointRun run(sp);
+  const RobustDetection& d = run.det;
   ASSERT_GT(accepted_count(d), 0u);
   const SeamCandidate& s = *best_accepted(d);
   EXPECT_GE(s.scale, 0.04 - 1e-9);
   EXPECT_NEAR(s.width, 0.10, 0.01);
   EXPECT_NEAR(s.opening_deg, 150, 5);
-  EXPECT_LT(path_errors(seam_trajectory(s, p), scan.truth.seams.at(0)).first, 0.0015);
+  EXPECT_LT(run.errors(s).first, 0.0015);
 }
 
 TEST(RobustDetect, RootOfTheAnalyticVGroove) {
