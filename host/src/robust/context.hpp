@@ -86,4 +86,8 @@ constexpr double kFootHeight = 0.003;
 /// Unaccepts the fillet and lap seams most of whose roots lie within kFootHeight of `plane`.
 void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& seams);
 
+/// The same against the support_plane of `map`, looked for only when an accepted corner seam
+/// is among `seams`.
+void reject_corners_on_table(const CreaseMap& map, std::vector<SeamCandidate>& seams);
+
 }  // namespace groovetrace::robust_detail

@@ -46,6 +46,11 @@ bool intersect(const Eigen::Vector2d& a, const Eigen::Vector2d& da, const Eigen:
   return out.allFinite();
 }
 
+// Turns `face`'s direction to run away from `root`, towards its point `on_line`.
+void point_away(Face& face, const Eigen::Vector2d& root, const Eigen::Vector2d& on_line) {
+  if ((on_line - root).dot(face.dir) < 0) face.dir = -face.dir;
+}
+
 // Fits a line to `face.pts` at Tukey `scale` (m) and points it away from `root`. Once the face
 // has an extent, the points within `zone` (m) of its far end stay out: a lap's upper plate edge
 // is rounded off there as a V's rims are, and the upper plate's top begins.
@@ -57,7 +62,8 @@ void fit_face(Face& face, const Eigen::Vector2d& root, double scale, double zone
   }
   const auto [c, d] = fit_line(used.size() >= 8 ? used : face.pts, scale);
   on_line = c;
-  face.dir = (c - root).dot(d) >= 0 ? d : Eigen::Vector2d(-d);
+  face.dir = d;
+  point_away(face, root, on_line);
 }
 
 // The corner's state as the fit moves it.
@@ -107,8 +113,8 @@ bool refit_corner(const std::vector<Eigen::Vector2d>& pts, Corner& c, double zon
   fit_face(c.left, c.root, scale, zone, on_l);
   fit_face(c.right, c.root, scale, zone, on_r);
   if (!intersect(on_l, c.left.dir, on_r, c.right.dir, c.root)) return false;
-  fit_face(c.left, c.root, scale, zone, on_l);  // re-orient away from the new root
-  fit_face(c.right, c.root, scale, zone, on_r);
+  point_away(c.left, c.root, on_l);
+  point_away(c.right, c.root, on_r);
   return true;
 }
 

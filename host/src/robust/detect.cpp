@@ -233,8 +233,7 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
     det.scales.push_back(search.summary);
     for (SeamCandidate& seam : search.seams) all.push_back(std::move(seam));
   }
-  if (const auto table = robust_detail::support_plane(searches.back().map))
-    robust_detail::reject_corners_on(*table, all);
+  robust_detail::reject_corners_on_table(searches.back().map, all);
   det.seams = one_scale_per_groove(std::move(all));
   for (ScaleSearchSummary& sum : det.scales) {
     for (const SeamCandidate& seam : det.seams) sum.kept += (seam.scale == sum.scale);

@@ -73,6 +73,8 @@ std::optional<SupportPlane> support_plane(const CreaseMap& map) {
   for (std::size_t k = 0; k < n; k += stride) {
     SupportPlane plane{map.points[k].cast<double>(), map.normals[k].cast<double>()};
     if (!plane.point.allFinite() || !(plane.normal.norm() > 0.5)) continue;
+    // A voxel on the best plane so far would refit to it again (most of a table's voxels).
+    if (best && std::abs(best->normal.dot(plane.point - best->point)) <= kPlaneTolerance) continue;
     if (table_support(map, plane) == 0) continue;
     plane = refit(map, plane);
     const std::size_t support = table_support(map, plane);
@@ -82,6 +84,14 @@ std::optional<SupportPlane> support_plane(const CreaseMap& map) {
     }
   }
   return best;
+}
+
+void reject_corners_on_table(const CreaseMap& map, std::vector<SeamCandidate>& seams) {
+  const bool any = std::any_of(seams.begin(), seams.end(),
+                               [](const SeamCandidate& s) { return s.accepted && s.corner; });
+  if (!any) return;  // the table is looked for only when a corner needs it
+  const std::optional<SupportPlane> table = support_plane(map);
+  if (table) reject_corners_on(*table, seams);
 }
 
 void reject_corners_on(const SupportPlane& plane, std::vector<SeamCandidate>& seams) {
