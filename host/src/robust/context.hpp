@@ -65,7 +65,8 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
 
 /// The seams of every scale's search, ranked best first, without the ones that repeat a better
 /// seam: a seam is dropped when half or more of its root line runs within the groove (half its
-/// width, at least 3 mm) of a seam kept before it. Order kept.
+/// width, at least 3 mm) of a seam kept before it, or when it reads only the bottom of a wider,
+/// better scored groove found at a coarser scale. Order kept.
 std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked);
 
 // --- support.cpp ----------------------------------------------------------------------------

@@ -21,25 +21,20 @@ double relative_spread(const std::vector<double>& v) {
   return mad_sigma(v, med) / med;
 }
 
-// A single bevel has one side square to the top (its dip over 75 deg: a wall measured steep
-// or a hidden side whose mirror image would have been seen) and the other at least 20 deg
-// flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
 // A corner seam (no top across it) is a fillet, or a lap where one face, the upper plate's
 // edge, ends inside the window and the upper plate's top follows: when a third of its passing
-// sections see that top (it holds only a few points of a narrow window).
+// sections see that top (it holds only a few points of a narrow window). A groove seam is a
+// bevel or a V (bevel_square_side).
 std::string joint_kind(const SeamCandidate& seam) {
-  std::vector<double> steep, flat;
-  std::size_t short_faces = 0;
-  for (const GrooveSection& s : seam.sections) {
-    if (!s.ok) continue;
-    short_faces += s.short_face;
-    steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
-    flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
+  if (seam.corner) {
+    std::size_t passing = 0, short_faces = 0;
+    for (const GrooveSection& s : seam.sections) {
+      passing += s.ok;
+      short_faces += s.ok && s.short_face;
+    }
+    return 3 * short_faces >= passing && short_faces > 0 ? "lap" : "fillet";
   }
-  if (seam.corner) return 3 * short_faces >= steep.size() && short_faces > 0 ? "lap" : "fillet";
-  if (steep.size() < 3) return "V";
-  const double hi = upper_median(steep), lo = upper_median(flat);
-  return hi >= 75 && hi - lo >= 20 ? "bevel" : "V";
+  return bevel_square_side(seam.sections) != 0 ? "bevel" : "V";
 }
 
 // Clamps and blocks standing on a part make corners along their feet that no cross-section
@@ -57,6 +52,24 @@ double median_misalignment(const std::vector<GrooveSection>& secs) {
 }
 
 }  // namespace
+
+// A single bevel has one side square to the top (its dip over 75 deg: a wall measured steep
+// or a hidden side whose mirror image would have been seen) and the other at least 20 deg
+// flatter; a V's walls dip alike (a D415 at a slant reads up to ~8 deg of difference).
+int bevel_square_side(const std::vector<GrooveSection>& sections) {
+  std::vector<double> steep, flat;
+  int right_steeper = 0;
+  for (const GrooveSection& s : sections) {
+    if (!s.ok || s.corner) continue;
+    steep.push_back(std::max(s.wall_left_deg, s.wall_right_deg));
+    flat.push_back(std::min(s.wall_left_deg, s.wall_right_deg));
+    right_steeper += s.wall_right_deg > s.wall_left_deg ? 1 : -1;
+  }
+  if (steep.size() < 3) return 0;
+  const double hi = upper_median(steep), lo = upper_median(flat);
+  if (!(hi >= 75 && hi - lo >= 20) || right_steeper == 0) return 0;
+  return right_steeper > 0 ? 1 : -1;
+}
 
 void score_seam(SeamCandidate& seam, const RobustParams& params) {
   std::vector<double> width, depth, opening, quality;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/stats.hpp"
 #include "robust/stages.hpp"
 #include "robust/vmodel.hpp"
 
@@ -118,6 +119,31 @@ void place_in_gap(const Profile& pr, const Eigen::Vector3d& origin, const Eigen:
   sec.why = "inferred from a gap in the top surface";
 }
 
+// The profile's fit; the view towards the sensor from the cloud's viewpoint.
+VProfile fit_profile(const Cloud& cloud, const Profile& pr, const Eigen::Vector3d& origin,
+                     double half_window, VFit mode) {
+  const Eigen::Vector3d to_sensor = cloud.viewpoint.cast<double>() - origin;
+  const Eigen::Vector2d view(to_sensor.dot(pr.a), to_sensor.dot(pr.n));
+  return fit_v_profile(
+      thinned(pr), half_window, mode,
+      view.norm() > 0 ? Eigen::Vector2d(view.normalized()) : Eigen::Vector2d(0, 1));
+}
+
+// A bevel seam's profile tilted by more than kLevelDeg (and less than kMaxLevelDeg) against
+// its own fitted top is fitted again level.
+constexpr double kLevelDeg = 1.0;
+constexpr double kMaxLevelDeg = 30.0;
+
+// `pr` turned about its tangent so that the unit `up` (in its (u, v)) becomes its v axis.
+Profile levelled(const Profile& pr, const Eigen::Vector2d& up) {
+  Profile out = pr;
+  const Eigen::Vector2d across(up.y(), -up.x());
+  out.n = (up.x() * pr.a + up.y() * pr.n).normalized();
+  out.a = out.n.cross(out.t);
+  for (auto& p : out.uv) p = Eigen::Vector2d(p.dot(across), p.dot(up));
+  return out;
+}
+
 }  // namespace
 
 GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& candidates,
@@ -125,17 +151,28 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
                           const Eigen::Vector3d& normal_hint, double slab, double half_window,
                           VFit mode) {
   GrooveSection sec;
-  const Profile pr = profile_of(cloud, candidates, origin, tangent, normal_hint, slab);
+  Profile pr = profile_of(cloud, candidates, origin, tangent, normal_hint, slab);
   if (!pr.ok) {
     sec.why = "degenerate frame";
     return sec;
   }
   sec.support = static_cast<int>(pr.uv.size());
-  const Eigen::Vector3d to_sensor = cloud.viewpoint.cast<double>() - origin;
-  const Eigen::Vector2d view(to_sensor.dot(pr.a), to_sensor.dot(pr.n));
-  const VProfile f =
-      fit_v_profile(thinned(pr), half_window, mode,
-                    view.norm() > 0 ? Eigen::Vector2d(view.normalized()) : Eigen::Vector2d(0, 1));
+  VProfile f = fit_profile(cloud, pr, origin, half_window, mode);
+  // The hint is the crease stage's plane normal, which a single bevel's inclined wall (on one
+  // side of the ball) tilts by up to 20 deg; a bevel seam's sections hold their square wall
+  // straight down in the profile's frame, so they are fitted again in the frame of their own
+  // top - not beyond kMaxLevelDeg, where the "top" is a face standing across the window (a web
+  // seen from its side at a 40 mm scale).
+  const double tilt = f.top[1] + 2 * f.top[2] * f.root.x();  // the top's slope at the root
+  if (mode.square != 0 && std::abs(tilt) > std::tan(deg_to_rad(kLevelDeg)) &&
+      std::abs(tilt) < std::tan(deg_to_rad(kMaxLevelDeg))) {
+    const Profile level = levelled(pr, Eigen::Vector2d(-tilt, 1).normalized());
+    VProfile g = fit_profile(cloud, level, origin, half_window, mode);
+    if (g.ok || !f.ok) {
+      pr = level;
+      f = g;
+    }
+  }
   auto to3 = [&](const Eigen::Vector2d& p) { return pr.at(origin, p.x(), p.y()); };
   sec.tangent = pr.t;
   sec.ok = f.ok;

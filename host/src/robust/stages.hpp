@@ -90,6 +90,10 @@ struct VFit {
   /// the top normal through the root, so a poorly sampled wall (a grazing view puts two image
   /// rows on it) takes its slope from the other and only its offset from its own points.
   bool symmetric = false;
+  /// A single bevel: the side whose wall is square to the top (-1 left, +1 right, 0 none). The
+  /// V is refitted with that wall straight down from its edge to the root (in a profile
+  /// levelled to its top), and where that side is hidden, its foot is the root.
+  int square = 0;
   /// The plates are set high-low: the two top sides are fitted with one slope and each its own
   /// height (their step held at what lines fitted to each side alone give), so the step does
   /// not tilt the top normal or move the edges. Not with `symmetric`.
@@ -169,6 +173,11 @@ SeamCurve smooth_curve(const std::vector<Eigen::Vector3d>& ordered, bool closed,
                        double spacing, const std::vector<Eigen::Vector3d>& normals = {});
 
 // --- Stage 4: seam candidates, scores, region ---------------------------------------------
+
+/// A single bevel's square side among a groove seam's sections: -1 left, +1 right, 0 when the
+/// seam is a V (its passing sections' steeper wall, in the median, dips 75 deg or more and
+/// 20 deg more than the other; the side is the one steeper in most of them).
+int bevel_square_side(const std::vector<GrooveSection>& sections);
 
 /// Scores a candidate and decides whether it is a V-groove seam (fills score, accepted,
 /// reason and the medians).

@@ -333,6 +333,7 @@ VFit seam_fit_mode(const std::vector<GrooveSection>& secs) {
   VFit mode;
   mode.stepped = stepped_seam(secs);
   mode.symmetric = !mode.stepped && symmetric_seam(secs);
+  mode.square = mode.stepped || mode.symmetric ? 0 : bevel_square_side(secs);
   return mode;
 }
 

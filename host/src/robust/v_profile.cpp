@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/stats.hpp"
@@ -126,13 +127,22 @@ bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
 
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
+// How the V's walls are tied in a fit (VFit): free; symmetric (both dip alike about the top
+// normal through the root); or one side square (a single bevel's: its wall straight down from
+// its edge to the root, in a profile levelled to the top).
+enum class Tie { free, symmetric, square_left, square_right };
+
 // The V's parameters as the Gauss-Newton fit moves them. Free: x = (root u, root v, u_left,
 // u_right, q0, q1). Symmetric: x[2] is the half width h and x[3] is unused (held at 0); the
 // edges lie at u_c -+ h, u_c the foot of the top normal through the root (on the top's tangent
-// line there), so both walls dip alike. The top's curvature q2 is held at the start's.
+// line there), so both walls dip alike. Square: the square side's edge lies a hair outside the
+// root's u (kept out of x: its entry is held at 0). The top's curvature q2 is held at the
+// start's.
 struct VParams {
   VModel start;
-  bool symmetric;
+  Tie tie;
+  // The square side's edge lies this far (m) outside the root, keeping the vertex order.
+  static constexpr double kHair = 1e-6;
 
   // u_c, with s the top's slope at the root and g its height above the root:
   // u_c = root u - s g / (1 + s^2).
@@ -145,10 +155,12 @@ struct VParams {
   Vec6 pack(const VModel& v) const {
     Vec6 x;
     x << v.root.x(), v.root.y(), v.u_left, v.u_right, v.q[0], v.q[1];
-    if (symmetric) {
+    if (tie == Tie::symmetric) {
       x[2] = 0.5 * (v.u_right - v.u_left);
       x[3] = 0;
     }
+    if (tie == Tie::square_left) x[2] = 0;
+    if (tie == Tie::square_right) x[3] = 0;
     return x;
   }
 
@@ -159,18 +171,25 @@ struct VParams {
     v.u_right = x[3];
     v.q[0] = x[4];
     v.q[1] = x[5];
-    if (symmetric) {
+    if (tie == Tie::symmetric) {
       const double uc = centre_u(x);
       v.u_left = uc - x[2];
       v.u_right = uc + x[2];
     }
+    if (tie == Tie::square_left) v.u_left = x[0] - kHair;
+    if (tie == Tie::square_right) v.u_right = x[0] + kHair;
     return v;
   }
 
   // d(free parameters) / d(x), for the chain rule: the identity when free.
   Mat6 chain(const Vec6& x) const {
     Mat6 M = Mat6::Identity();
-    if (!symmetric) return M;
+    if (tie == Tie::square_left || tie == Tie::square_right) {
+      const int k = tie == Tie::square_left ? kLeftU : kRightU;
+      M.row(k).setZero();
+      M(k, kRootU) = 1;
+    }
+    if (tie != Tie::symmetric) return M;
     const double s = x[5] + 2 * start.q[2] * x[0];
     const double g = x[4] + x[5] * x[0] + start.q[2] * x[0] * x[0] - x[1];
     const double n = 1 + s * s;
@@ -260,10 +279,10 @@ bool descend(const std::vector<Eigen::Vector2d>& pts, const VParams& par, double
 
 // Gauss-Newton on (root u, root v, u_left, u_right, q0, q1) with analytic derivatives and
 // Tukey weights from the current residuals (at scale `scale`, m), the points within `zone` (m)
-// of a vertex left out; `symmetric` as in VParams. False, `m` untouched, when it diverges.
+// of a vertex left out; `tie` as in VParams. False, `m` untouched, when it diverges.
 bool refine_v(const std::vector<Eigen::Vector2d>& pts, VModel& m, double scale, double zone,
-              double coarse, bool symmetric) {
-  const VParams par{m, symmetric};
+              double coarse, Tie tie) {
+  const VParams par{m, tie};
   Vec6 x = par.pack(m);
   // Graduated: a wide Tukey window first (`coarse`, m), so that a start a few millimetres off
   // still sees the walls, then halving down to the noise.
@@ -596,22 +615,26 @@ bool unseen_rim(const Eigen::Vector3d& q, const ProfileFit& f, bool left_missing
 }
 
 // `one`'s opening from the unseen rim at u = `edge` to the seen wall's rim, and its root where
-// the top normal through u = `uc` (the opening's centre for a symmetric V, just inside the
-// unseen rim for a square side) meets the seen wall (running `up` to its rim). False when the
-// two are parallel or the root falls outside the opening.
+// the top normal through the top at u = `uc` meets the seen wall (running `up` to its rim).
+// With `lean_out` (uc the rim of a bevel's square side), where that normal leans out of the
+// opening (a frame tilted against the top by a few degrees: 0.4 mm at 8 mm depth), the rim
+// moves out with the root, which keeps the model's vertex order. False when the two are
+// parallel or the root falls outside the opening.
 bool root_below(const Eigen::Vector2d& seen_edge, const Eigen::Vector2d& up, double edge, double uc,
-                bool left_missing, VModel& one) {
-  const Eigen::Vector3d& q = one.q;
-  const Eigen::Vector2d centre(uc, top_at(q, uc));
-  const Eigen::Vector2d axis = -Eigen::Vector2d(-(q[1] + 2 * q[2] * uc), 1).normalized();
+                bool lean_out, bool left_missing, VModel& one) {
+  const Eigen::Vector2d centre(uc, top_at(one.q, uc));
+  const double slope = one.q[1] + 2 * one.q[2] * uc;
   Eigen::Matrix2d M;
-  M.col(0) = axis;
+  M.col(0) = Eigen::Vector2d(slope, -1).normalized();  // down the top normal
   M.col(1) = up;
   if (std::abs(M.determinant()) < 1e-6) return false;
   const Eigen::Vector2d ts = M.inverse() * (seen_edge - centre);
-  one.root = centre + ts.x() * axis;
+  one.root = centre + ts.x() * M.col(0);
+  const double hair = 1e-6;
   one.u_left = left_missing ? edge : seen_edge.x();
   one.u_right = left_missing ? seen_edge.x() : edge;
+  if (lean_out && left_missing) one.u_left = std::min(one.u_left, one.root.x() - hair);
+  if (lean_out && !left_missing) one.u_right = std::max(one.u_right, one.root.x() + hair);
   return one.u_left < one.root.x() && one.root.x() < one.u_right;
 }
 
@@ -628,14 +651,30 @@ bool mirror_would_show(const ProfileFit& f, const Eigen::Vector3d& q, double uc,
   return face.dot(f.view) > std::cos(deg_to_rad(kShownIncidenceDeg));
 }
 
+// Whether the seen wall of a square-sided `one` runs down to its foot: a square side hidden
+// because the sensor looks along it sees the other wall to the bottom. A wall that ends far
+// above the root is something else (a plate standing on a plate at 40 mm put a "foot" metres
+// below a steep face).
+bool reaches_foot(const std::vector<Eigen::Vector2d>& groove, const VModel& one,
+                  const ProfileFit& f) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& p : groove) lowest = std::min(lowest, p.y());
+  const double depth = one.top(one.root.x(), false) - one.root.y();
+  return lowest - one.root.y() <= std::max(2 * f.vertex_zone, 0.2 * depth);
+}
+
 // 6. One wall seen, the other returned no or a few stray points (which the two-wall fit `m`
 //    then bends into a vertical or flat wall): the unseen wall's edge is where the top surface
 //    ends, half a sample spacing past the last top point. Hidden at a grazing angle, the V is
 //    symmetric about the top normal through the opening's centre, so the root lies where that
 //    axis meets the seen wall; hidden though its mirror image would face the sensor, that side
-//    is square (a single bevel seen along its square side) and the root is at its foot.
+//    is square (a single bevel seen along its square side) and the root is at its foot. Where
+//    the seam's first pass has decided (`mode`), that decides: a V's hidden wall is grazing
+//    (at 640x480 and a 15 deg tilt, the seen wall's noisy dip made its mirror "show" in a few
+//    sections, each then rooted at the rim's foot), a bevel's hidden side is its square one.
 //    `two_wall` (m's profile) when that does not apply or fails to fit.
-VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit& f) {
+VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit& f,
+                    const std::vector<Eigen::Vector2d>& groove, const VFit& mode) {
   auto seen = [](int points, double dip) {
     return points >= 2 * kMinWall && dip >= 8 && dip <= kMaxDipDeg;
   };
@@ -651,10 +690,16 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
     return two_wall;
   }
   const double centre = 0.5 * (edge + seen_edge.x());
-  const bool square = mirror_would_show(f, m.q, centre, up, left_missing);
-  // A square side's foot, a hair inside its rim so that the model keeps its vertex order.
-  const double inside = 1e-3 * f.W * (left_missing ? 1 : -1);
-  if (!root_below(seen_edge, up, edge, square ? edge + inside : centre, left_missing, one)) {
+  const bool square = mode.symmetric     ? false
+                      : mode.square != 0 ? mode.square == (left_missing ? -1 : 1)
+                                         : mirror_would_show(f, m.q, centre, up, left_missing);
+  // A square side's foot lies below its rim; on a seam known to be a bevel its rim moves out
+  // with a foot that leans out, elsewhere the foot must lie (a hair) inside the opening.
+  const bool lean_out = square && mode.square != 0;
+  const double inside = square && !lean_out ? 1e-3 * f.W * (left_missing ? 1 : -1) : 0.0;
+  if (!root_below(seen_edge, up, edge, square ? edge + inside : centre, lean_out, left_missing,
+                  one) ||
+      (square && !reaches_foot(groove, one, f))) {
     return two_wall;
   }
   VProfile alt = judge_v(one, true, f);
@@ -695,17 +740,26 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
   //    vertices do not count: rounded rims and the root gap are not the V's planes.
   f.scale = std::max(f.sigma, 0.005 * f.W);
   f.vertex_zone = std::max(2 * f.sigma, 0.06 * f.W);
-  if (!refine_v(f.pts, m, f.scale, f.vertex_zone, 0.1 * f.W, false)) {
+  if (!refine_v(f.pts, m, f.scale, f.vertex_zone, 0.1 * f.W, Tie::free)) {
     out.why = "V fit did not converge";
     return out;
   }
-  if (mode.symmetric && !mode.stepped) {
-    VModel sym = m;
-    if (refine_v(f.pts, sym, f.scale, f.vertex_zone, 0.1 * f.W, true)) m = sym;
+  const Tie tie = mode.stepped      ? Tie::free
+                  : mode.symmetric  ? Tie::symmetric
+                  : mode.square < 0 ? Tie::square_left
+                  : mode.square > 0 ? Tie::square_right
+                                    : Tie::free;
+  if (tie != Tie::free) {
+    VModel tied = m;
+    if (tie != Tie::symmetric) {  // the square side's edge straight above the root
+      (tie == Tie::square_left ? tied.u_left : tied.u_right) =
+          tied.root.x() + (tie == Tie::square_left ? -1 : 1) * VParams::kHair;
+    }
+    if (refine_v(f.pts, tied, f.scale, f.vertex_zone, 0.1 * f.W, tie)) m = tied;
   }
   const VProfile two_wall = judge_v(m, false, f);
   if (two_wall.ok) return two_wall;
-  return one_wall_v(m, two_wall, f);
+  return one_wall_v(m, two_wall, f, groove, mode);
 }
 
 }  // namespace
