@@ -89,7 +89,7 @@ struct SeamCandidate {
     double position = 0.0, length = 0.0;
   };
   std::vector<Tack> tacks;
-  double misalignment = 0.0;  ///< median |high-low| of the tops over the ok sections (m)
+  double misalignment = 0.0;  ///< |median high-low| of the tops over the ok sections (m)
   double scale = 0.0;         ///< the search scale it was found at (m; RobustParams::scales)
   bool accepted = false;
   std::string reason;   ///< why rejected (empty when accepted)
