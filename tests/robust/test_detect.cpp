@@ -241,7 +241,8 @@ TEST(RobustDetect, SingleBevelIsFoundAtTheFootOfItsSquareSide) {
   EXPECT_EQ(best_accepted(d)->joint, "bevel");
   const auto [dist, angle] = run.errors(*best_accepted(d));
   EXPECT_LT(dist, 0.0012);
-  EXPECT_LT(angle, 4.0);  // 3.1 deg here at 640x480; the issue asks 2 deg on the sweep (not met)
+  // 1.2 deg with the bevel's square wall held square (VFit::square); 3.1 deg with both free.
+  EXPECT_LT(angle, 2.0);
 }
 
 // The same bevel at 1280x720 (synth defaults, seed 1): its 10 mm reading fails the 40 % V
@@ -257,8 +258,10 @@ TEST(RobustDetect, SingleBevelIsReadAtACoarserScaleWhenTheBaseFails) {
   ASSERT_GT(accepted_count(d), 0u);
   EXPECT_EQ(best_accepted(d)->joint, "bevel");
   const auto [dist, angle] = run.errors(*best_accepted(d));
-  EXPECT_LT(dist, 0.0014);  // 1.15 mm, of which 0.5 mm is the gap's depth convention
-  EXPECT_LT(angle, 1.5);    // 0.53 deg
+  // 1.25 mm, of which 0.56 mm is the truth's convention: its root is the 0.5 mm gap's centre,
+  // 0.25 mm across and 0.5 mm above the square side's foot, where the walls meet.
+  EXPECT_LT(dist, 0.0014);
+  EXPECT_LT(angle, 1.5);  // 1.06 deg
 }
 
 // A fillet (T-joint: a web standing on a plate) seen down its bisector: no top surface across
