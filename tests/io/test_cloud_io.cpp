@@ -56,8 +56,9 @@ pcl::PointCloud<pcl::PointXYZ> sample_cloud(std::size_t n, std::vector<std::size
   c.height = 1;
   c.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    c[i].x = static_cast<float>(i);
-    c[i].y = 2.0f * static_cast<float>(i);
+    // Multiples of 1/4 and 1/2 m: exact in ASCII, and within kMaxCoordinate for 2000 points.
+    c[i].x = 0.25f * static_cast<float>(i);
+    c[i].y = 0.5f * static_cast<float>(i);
     c[i].z = 0.5f + static_cast<float>(i) / 1000.0f;
   }
   for (std::size_t i : nan_at) c[i].x = c[i].y = c[i].z = kNaN;
@@ -246,7 +247,7 @@ TEST_F(CloudIo, WindowsLineEndsBlankLinesAndCommentsAreAccepted) {
 
 TEST_F(CloudIo, NanPointsStayInPlace) {
   std::string data = xyz_lines(120);
-  data += "nan nan nan\n5 nan 1\n1000 2000 1\n";
+  data += "nan nan nan\n5 nan 1\n100 200 1\n";
   const fs::path p = file("holes.pcd", ascii_pcd("x y z", 123, 1, 123, data));
   const Cloud got = read_cloud(p.string());
   ASSERT_EQ(got.size(), 123u);
@@ -254,7 +255,7 @@ TEST_F(CloudIo, NanPointsStayInPlace) {
   EXPECT_FALSE(got.valid(121));
   EXPECT_TRUE(std::isnan(got.x[121])) << "a partly NaN point must be NaN in every coordinate";
   EXPECT_TRUE(got.valid(122));
-  EXPECT_EQ(got.x[122], 1000.0f);
+  EXPECT_EQ(got.x[122], 100.0f);
   EXPECT_EQ(got.x[119], 119.0f);
   EXPECT_EQ(got.count_valid(), 121u);
 }
@@ -321,7 +322,7 @@ TEST_F(CloudIo, Float64FieldsBinary) {
       "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 130\nHEIGHT 1\n"
       "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 130\nDATA binary\n";
   for (std::size_t i = 0; i < n; ++i) {
-    const double v[3] = {0.1 * static_cast<double>(i), -1e-3, 12345.678901};
+    const double v[3] = {0.1 * static_cast<double>(i), -1e-3, 123.45678901};
     text.append(reinterpret_cast<const char*>(v), sizeof(v));
   }
   const fs::path p = file("double.pcd", text);
@@ -329,7 +330,7 @@ TEST_F(CloudIo, Float64FieldsBinary) {
   ASSERT_EQ(got.size(), n);
   EXPECT_EQ(got.x[77], static_cast<float>(0.1 * 77));
   EXPECT_EQ(got.y[77], static_cast<float>(-1e-3));
-  EXPECT_EQ(got.z[77], static_cast<float>(12345.678901));
+  EXPECT_EQ(got.z[77], static_cast<float>(123.45678901));
 }
 
 TEST_F(CloudIo, PlyAsciiAndBinaryRoundTrip) {
@@ -554,6 +555,25 @@ TEST_F(CloudIo, InfiniteCoordinates) {
     text.append(reinterpret_cast<const char*>(v), sizeof(v));
   }
   expect_rejected(file("big.pcd", text), "has 1 point with infinite coordinates");
+}
+
+// A coordinate beyond a kilometre is a corrupt file or a wrong unit: one point at 1e8 m
+// crashed the OpenCL crease kernel (its cell keys overflow 32-bit ints), at 1e16 m the CPU
+// path's 64-bit keys. The bound applies after units.
+TEST_F(CloudIo, CoordinatesBeyondAKilometre) {
+  expect_rejected(file("far.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(119) + "1e8 1 1\n")),
+                  "has 1 point beyond 1000 m");
+  EXPECT_EQ(
+      read_cloud(file("edge.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(119) + "-1000 1 1\n"))
+                     .string())
+          .count_valid(),
+      120u);
+  const fs::path mm_file =
+      file("mm.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(119) + "1 900000 1\n"));
+  ReadOptions mm;
+  mm.units_scale = 0.001;
+  EXPECT_EQ(read_cloud(mm_file.string(), mm).count_valid(), 120u);  // 900 m
+  expect_rejected(mm_file, "has 1 point beyond 1000 m");            // 900 km
 }
 
 TEST_F(CloudIo, FailuresPrintNothing) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <groovetrace/error.hpp>
 #include <groovetrace/robust.hpp>
 #include <groovetrace/synth.hpp>
 #include <optional>
@@ -458,6 +459,19 @@ TEST(RobustDetect, RobotBaseFrameWithItsViewpoint) {
     EXPECT_LT(best, 0.002);
     EXPECT_GT(z_near.dot(w.orientation.toRotationMatrix().col(2)), std::cos(3 * M_PI / 180));
   }
+}
+
+// Called as a library (no reader in front), a cloud with a point at 1e16 m ran into signed
+// overflow in the voxel keys and ended in "no groove found"; it is an input error.
+TEST(RobustDetect, PointBeyondAKilometreIsAnInputError) {
+  test::VGrooveScene s;
+  s.width = 160;
+  s.height = 120;
+  Cloud cloud = test::render_vgroove(s).cloud;
+  cloud.z[100] = 1e16f;
+  EXPECT_THROW(detect_robust(cloud, RobustParams{}), InputError);
+  cloud.z[100] = -1e8f;
+  EXPECT_THROW(detect_robust(cloud, RobustParams{}), InputError);
 }
 
 TEST(RobustDetect, EmptyAndFlatScansFindNothing) {

@@ -38,6 +38,17 @@ struct GT_API Cloud {
   }
 };
 
+/// The farthest a scan's point may lie from its frame's origin in any coordinate (m). A depth
+/// camera's returns end within ten metres and a robot cell within a few; beyond a kilometre a
+/// coordinate is a corrupt file or a wrong unit, and its voxel keys would overflow the
+/// integers the grids index with (a point at 1e8 m crashed the OpenCL crease kernel).
+constexpr double kMaxCoordinate = 1000.0;
+
+/// Throws InputError (exit 3) naming the first valid point of `cloud` with a coordinate beyond
+/// +-kMaxCoordinate, and how many there are. Every entry that grids a cloud calls it: the
+/// readers, detect_robust and the backends.
+GT_API void require_in_range(const Cloud& cloud);
+
 /// Unit surface normals per point, in the cloud's frame; NaN where a point has too few
 /// neighbours (such points are never groove).
 struct GT_API Normals {

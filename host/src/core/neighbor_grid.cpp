@@ -6,6 +6,7 @@
 namespace groovetrace {
 
 NeighborGrid::NeighborGrid(const Cloud& cloud, float cell) : inv_cell_(1.0f / cell) {
+  require_in_range(cloud);  // cell keys stay far inside their integers
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   keyed.reserve(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {

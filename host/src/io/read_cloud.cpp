@@ -4,6 +4,7 @@
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <groovetrace/cloud_io.hpp>
@@ -45,7 +46,7 @@ Cloud to_cloud(const Decoded& decoded, double scale, std::size_t min_valid) {
   cloud.viewpoint = (decoded.origin.head<3>().cast<double>() * scale).cast<float>();
 
   std::vector<float>* out[3] = {&cloud.x, &cloud.y, &cloud.z};
-  std::size_t infinite = 0;
+  std::size_t infinite = 0, beyond = 0;
   // Both readers return rows back to back (the data sizes were checked), so point i of the
   // file is at i * point_step whatever row_step says.
   for (std::size_t i = 0; i < n; ++i) {
@@ -56,13 +57,21 @@ Cloud to_cloud(const Decoded& decoded, double scale, std::size_t min_valid) {
           static_cast<float>(field_value(point + fields[k]->offset, fields[k]->datatype) * scale);
     }
     // Coordinates beyond float range become inf here and are rejected with the infinities.
-    if (std::isinf(v[0]) || std::isinf(v[1]) || std::isinf(v[2])) ++infinite;
+    if (std::isinf(v[0]) || std::isinf(v[1]) || std::isinf(v[2])) {
+      ++infinite;
+    } else if (std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}) > kMaxCoordinate) {
+      ++beyond;
+    }
     // A point missing any coordinate is no point at all; downstream tests x alone.
     if (std::isnan(v[0]) || std::isnan(v[1]) || std::isnan(v[2])) v[0] = v[1] = v[2] = NAN;
     for (int k = 0; k < 3; ++k) (*out[k])[i] = v[k];
   }
   if (infinite > 0) {
     reject("has " + count_of(infinite, "point") + " with infinite coordinates");
+  }
+  if (beyond > 0) {
+    reject("has " + count_of(beyond, "point") + " beyond 1000 m of the frame's origin (a corrupt " +
+           "scan, or a wrong --units)");
   }
   const std::size_t valid = cloud.count_valid();
   if (valid == 0) reject("has no valid points (all " + std::to_string(n) + " are NaN)");

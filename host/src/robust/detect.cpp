@@ -207,6 +207,7 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
 RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               FeatureBackend& backend,
                               const std::function<void(const std::string&)>& lap) {
+  require_in_range(cloud);  // the voxel keys of every scale stay far inside 64 bits
   RobustDetection det;
   det.groove.assign(cloud.size(), 0);
   std::vector<double> scales = params.scales;

@@ -344,6 +344,7 @@ class OpenClBackend final : public FeatureBackend {
 
   // `grid`: the grid search even for a pinhole frame.
   Frame upload(const Cloud& cloud, float radius, bool grid = false) {
+    require_in_range(cloud);  // the kernels' cell keys are 32-bit ints
     // Kernels index with 32-bit ints, and the grid table holds 2 slots per point.
     if (cloud.size() >= (std::size_t{1} << 30)) {
       throw InternalError("the OpenCL backend takes at most 2^30 points per cloud");
