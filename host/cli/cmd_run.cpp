@@ -30,6 +30,8 @@ struct RunOptions {
 
 // Fails before any work if OUTDIR cannot be created or written, so a long run is not lost.
 void check_output_dir(const std::string& dir) {
+  // An empty path has no absolute form (std::filesystem threw: exit 5, "internal").
+  if (dir.empty()) throw UsageError("-o: the output directory is an empty path");
   fs::path p = fs::absolute(dir);
   std::error_code ec;
   if (fs::exists(p, ec) && !fs::is_directory(p, ec)) {

@@ -88,6 +88,16 @@ TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
   EXPECT_NE(r.err.find("no-such-device-name"), std::string::npos) << r.err;
 }
 
+TEST_F(CliBackend, DeviceIndexPastAnyNumberIsAUsageError) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  // Past unsigned long, std::stoul threw: exit 5, "internal: stoul".
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
+                                   " --method paper --device 99999999999999999999",
+                               dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no OpenCL device 99999999999999999999"), std::string::npos) << r.err;
+}
+
 // The default run (--method robust, --backend auto) measures the creases with OpenCL on a
 // machine that has a device, and report.json names it; without a platform it falls back to the
 // cpu and says so.

@@ -1,6 +1,7 @@
 // Every bad input to `groovetrace run`: one line on stderr, the documented exit code, and
 // no output file left behind.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <groovetrace/cloud_io.hpp>
 
@@ -212,6 +213,28 @@ TEST_F(BadInput, BadConfigFiles) {
   expect_failure(scan + " --config " + write("c4.yaml", "orientation_blend: -1\n").string(), 2,
                  "orientation_blend");
   expect_failure(scan + " --config " + (dir_ / "missing.yaml").string(), 3, "missing.yaml");
+  // A list inside a list is no value (yaml-cpp's "bad conversion": exit 5 before).
+  expect_failure(scan + " --config " + write("c5.yaml", "radius: [[0.003]]\n").string(), 2,
+                 "radius must be a value");
+  // 100,000 nested brackets overflowed the parser's stack: a segfault with nothing printed.
+  const std::string deep(100000, '[');
+  expect_failure(scan + " --config " + write("c6.yaml", "radius: " + deep).string(), 3,
+                 "nests brackets deeper than 64");
+  expect_failure(scan + " --config " + write("c7.json", "{\"radius\": " + deep).string(), 3,
+                 "nests brackets deeper than 64");
+  // Only regular files: a directory was silently ignored (exit 0), a FIFO hung the run.
+  fs::create_directory(dir_ / "c8.yaml");
+  expect_failure(scan + " --config " + (dir_ / "c8.yaml").string(), 3, "is a directory");
+  ASSERT_EQ(::mkfifo((dir_ / "c9.yaml").c_str(), 0600), 0);
+  expect_failure(scan + " --config " + (dir_ / "c9.yaml").string(), 3, "not a regular file");
+}
+
+TEST_F(BadInput, EmptyOutputPath) {
+  // std::filesystem has no absolute form of "": exit 5, "internal", before.
+  const auto r = test::run_cli("run " + good_scan().string() + " -o ''", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("empty path"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
 TEST_F(BadInput, BadCalibrationFiles) {
@@ -223,6 +246,18 @@ TEST_F(BadInput, BadCalibrationFiles) {
   expect_failure(
       scan + " --hand-eye " + (dir_ / "none.yaml").string() + " --flange-pose " + good.string(), 3,
       "none.yaml");
+  // A translation of 1e300 m ran the scan and failed in the URScript writer (exit 5).
+  const fs::path far = write("far.yaml", "translation: [1e300, 0, 0]\nrotation: [0, 0, 0, 1]\n");
+  expect_failure(scan + " --hand-eye " + far.string() + " --flange-pose " + good.string(), 3,
+                 "beyond the 1000 m");
+  // A FIFO hung the read; deep nesting overflowed the parser's stack.
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.yaml").c_str(), 0600), 0);
+  expect_failure(
+      scan + " --hand-eye " + (dir_ / "fifo.yaml").string() + " --flange-pose " + good.string(), 3,
+      "not a regular file");
+  const fs::path deep = write("deep.json", "{\"translation\": " + std::string(100000, '['));
+  expect_failure(scan + " --hand-eye " + deep.string() + " --flange-pose " + good.string(), 3,
+                 "nests brackets deeper than 64");
 }
 
 }  // namespace

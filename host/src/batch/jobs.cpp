@@ -105,8 +105,7 @@ void make_unique(std::vector<ScanJob>& jobs) {
 }  // namespace
 
 std::vector<ScanJob> read_manifest(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read manifest " + path);
+  std::istringstream in(io::read_all(path));  // a regular file: a FIFO would hang the batch
   std::string line;
   std::getline(in, line);
   const std::vector<std::string> header = csv_cells(line);

@@ -36,7 +36,7 @@ std::string count_of(std::uint64_t n, const char* noun) {
   return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
-std::string read_all(const std::string& path) {
+std::string read_all(const std::string& path, bool allow_empty) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     throw InputError("cannot read " + shown(path) + ": " + std::strerror(errno));
@@ -55,8 +55,29 @@ std::string read_all(const std::string& path) {
     // The file shrank under us or the device failed; either way the data is not all there.
     throw InputError("cannot read " + shown(path) + ": read error");
   }
-  if (content.empty()) throw InputError(shown(path) + " is empty");
+  if (content.empty() && !allow_empty) throw InputError(shown(path) + " is empty");
   return content;
+}
+
+void require_shallow(const std::string& text, const std::string& path) {
+  int depth = 0;
+  bool quoted = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (quoted) {
+      if (c == '\\') ++k;  // an escaped character, a quote among them
+      quoted = c != '"';
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) {
+        throw InputError(shown(path) + " nests brackets deeper than " +
+                         std::to_string(kMaxNesting) + " levels");
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
 }
 
 std::string lower_extension(const std::string& path) {

@@ -28,8 +28,15 @@ std::string shown(std::string_view text, std::size_t max_len = 4096);
 std::string count_of(std::uint64_t n, const char* noun);
 
 // The file's bytes; InputError (one line, naming the path) if it is missing, not a regular
-// file, unreadable or empty.
-std::string read_all(const std::string& path);
+// file (a FIFO would hang the read, a directory read as nothing), unreadable, or empty unless
+// `allow_empty`.
+std::string read_all(const std::string& path, bool allow_empty = false);
+
+// Throws InputError when `text` (a config or calibration file's, named `path`) nests its
+// brackets or braces deeper than kMaxNesting: the YAML and JSON parsers recurse per level,
+// and 100,000 nested '[' overflowed the stack (a segfault, nothing printed).
+constexpr int kMaxNesting = 64;
+void require_shallow(const std::string& text, const std::string& path);
 // ".pcd" for "dir/Scan.PCD"; "" when the file name has no extension.
 std::string lower_extension(const std::string& path);
 

@@ -10,11 +10,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <groovetrace/cloud.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/frames.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
+
+#include "io/text.hpp"
 
 namespace groovetrace {
 
@@ -35,15 +38,11 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+// Regular files only (a FIFO hung the read), nested no deeper than the parsers can take.
 std::string read_text(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(path, "cannot read transform: is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot read transform: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) fail(path, "cannot read transform: read error");
-  return text.str();
+  std::string text = io::read_all(path, true);
+  io::require_shallow(text, path);
+  return text;
 }
 
 std::string format_number(double v) {
@@ -147,6 +146,14 @@ Eigen::Isometry3d read_transform(const std::string& path) {
     q = json_numbers(path, root, "rotation", 4);
   }
 
+  // A robot cell is metres across: a translation beyond kMaxCoordinate is a wrong unit or a
+  // corrupt file (1e300 m ran the whole scan and failed in the URScript writer, exit 5).
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (std::abs(t[i]) > kMaxCoordinate) {
+      fail(path, "translation[" + std::to_string(i) + "] is " + format_number(t[i]) +
+                     " m, beyond the " + format_number(kMaxCoordinate) + " m a cell can hold");
+    }
+  }
   // File order is x, y, z, w (ROS); Eigen's constructor takes w first.
   Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
   const double norm = rotation.norm();

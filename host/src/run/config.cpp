@@ -1,5 +1,6 @@
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -8,6 +9,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "io/text.hpp"
 
 namespace groovetrace {
 namespace {
@@ -311,11 +314,19 @@ void set_param(Params& params, const std::string& key, const std::string& value)
   throw UsageError("unknown parameter '" + key + "'");
 }
 
+namespace {
+
+// A YAML key for a message: its text, or "a key" when it is no scalar.
+std::string shown_key(const YAML::Node& key) {
+  return key.IsScalar() ? key.as<std::string>() : std::string("a key");
+}
+
+}  // namespace
+
 std::vector<std::string> apply_config_file(Params& params, const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot read config file " + path);
   std::stringstream buf;
-  buf << in.rdbuf();
+  buf << io::read_all(path, true);
+  io::require_shallow(buf.str(), path);
   std::vector<std::pair<std::string, std::string>> entries;
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
@@ -348,15 +359,21 @@ std::vector<std::string> apply_config_file(Params& params, const std::string& pa
     if (root.IsNull()) return {};
     if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
     for (const auto& kv : root) {
+      // A key or list element that is itself a list or map is no value (yaml-cpp's "bad
+      // conversion" was exit 5).
+      const bool scalars = std::all_of(kv.second.begin(), kv.second.end(),
+                                       [](const YAML::Node& e) { return e.IsScalar(); });
+      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || (kv.second.IsSequence() && scalars))) {
+        throw UsageError("config file " + path + ": " + shown_key(kv.first) +
+                         " must be a value or a list of values");
+      }
       const std::string k = kv.first.as<std::string>();
       if (kv.second.IsSequence()) {
         std::string joined;
         for (const auto& e : kv.second) joined += (joined.empty() ? "" : ",") + e.as<std::string>();
         entries.emplace_back(k, joined);
-      } else if (kv.second.IsScalar()) {
-        entries.emplace_back(k, kv.second.as<std::string>());
       } else {
-        throw UsageError("config file " + path + ": " + k + " must be a value or a list");
+        entries.emplace_back(k, kv.second.as<std::string>());
       }
     }
   } else {

@@ -99,8 +99,9 @@ cl::Device select_device(const std::string& selector) {
   const bool numeric = std::all_of(selector.begin(), selector.end(),
                                    [](unsigned char c) { return std::isdigit(c) != 0; });
   if (numeric) {
-    const unsigned long k = std::stoul(selector);
-    if (k < devices.size()) return devices[k];
+    // Compared as text first: stoul throws on an index past its range (exit 5, "stoul").
+    const bool small = selector.size() <= 9;
+    if (small && std::stoul(selector) < devices.size()) return devices[std::stoul(selector)];
     throw UsageError("device: no OpenCL device " + selector + " (devices: " + list + ")");
   }
   for (const auto& d : devices) {
