@@ -1,5 +1,8 @@
 // groovetrace CLI: subcommands run, synth, eval. Every failure ends as one line on stderr
 // and the exit code of docs/design.md ("CLI contract").
+#include <unistd.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <groovetrace/error.hpp>
@@ -11,16 +14,26 @@
 
 namespace {
 
-// A kernel build failure's compiler log runs to many lines: it goes to a file in the temporary
-// directory ($TMPDIR), named on the error's one line. Returns the path, or "" when unwritable.
+// A kernel build failure's compiler log runs to many lines: it goes to a new file in the
+// temporary directory ($TMPDIR), named on the error's one line. The name is made unique and
+// the file created exclusively (mkstemps: O_EXCL, mode 0600): a fixed name was written
+// through whatever symlink another user had planted there. Returns the path, or "" when
+// unwritable.
 std::string save_build_log(const std::string& log) {
   std::error_code ec;
   const auto dir = std::filesystem::temp_directory_path(ec);
   if (ec) return "";
-  const auto path = dir / "groovetrace-opencl-build.log";
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << log;
-  return out.good() ? path.string() : "";
+  std::string path = (dir / "groovetrace-opencl-build-XXXXXX.log").string();
+  const int fd = ::mkstemps(path.data(), 4);
+  if (fd < 0) return "";
+  std::size_t done = 0;
+  while (done < log.size()) {
+    const ssize_t n = ::write(fd, log.data() + done, log.size() - done);
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  const bool ok = ::close(fd) == 0 && done == log.size();
+  return ok ? path : "";
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // `opencl` is an error (exit 5), not a silent fallback.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <groovetrace/cloud_io.hpp>
 #include <groovetrace/opencl.hpp>
 #include <nlohmann/json.hpp>
@@ -62,6 +63,11 @@ TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
 TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
+  // The log's old fixed name, planted as a symlink to a file of someone else's: the log went
+  // through it and overwrote that file.
+  const fs::path victim = dir_ / "victim.txt";
+  std::ofstream(victim) << "keep me\n";
+  fs::create_symlink(victim, dir_ / "groovetrace-opencl-build.log");
   const std::string env =
       "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";  // common.cl refuses it
   const auto r = test::run_cli(
@@ -74,9 +80,13 @@ TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
   for (std::string line; std::getline(lines, line);) ours += line.rfind("groovetrace:", 0) == 0;
   EXPECT_EQ(ours, 1) << r.err;
   EXPECT_NE(r.err.find("failed to build"), std::string::npos) << r.err;
-  const fs::path log = dir_ / "groovetrace-opencl-build.log";
-  EXPECT_NE(r.err.find(log.string()), std::string::npos) << r.err;
-  EXPECT_NE(test::read_text(log).find("VW must be"), std::string::npos);
+  const std::string prefix = (dir_ / "groovetrace-opencl-build-").string();
+  const std::size_t at = r.err.find(prefix);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const fs::path log = r.err.substr(at, r.err.find(')', at) - at);
+  EXPECT_EQ(log.extension(), ".log") << log;
+  EXPECT_NE(test::read_text(log).find("VW must be"), std::string::npos) << log;
+  EXPECT_EQ(test::read_text(victim), "keep me\n");
   EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out));
 }
 
