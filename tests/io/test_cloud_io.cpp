@@ -576,6 +576,43 @@ TEST_F(CloudIo, CoordinatesBeyondAKilometre) {
   expect_rejected(mm_file, "has 1 point beyond 1000 m");            // 900 km
 }
 
+// An ASCII PLY of `n` vertices with `extra` header lines before the vertex element and
+// `after` header lines after it; `data_after` follows the vertex lines.
+std::string crafted_ply(int n, const std::string& extra, const std::string& after = "",
+                        const std::string& data_after = "") {
+  return "ply\nformat ascii 1.0\n" + extra + "element vertex " + std::to_string(n) +
+         "\nproperty float x\nproperty float y\nproperty float z\n" + after + "end_header\n" +
+         xyz_lines(static_cast<std::size_t>(n)) + data_after;
+}
+
+// PLY headers PCL's reader mishandles are refused before it reads them: a range_grid (its
+// vertex indices are written through unchecked: -1 crashed it), an obj_info grid that is not
+// the vertices' shape (1 x 1 for 120 vertices tripped an assertion, exit 134; 2000 x 2000
+// made a 4-million-point cloud from a small file), an element count beyond the file's size
+// (2^64 - 1 entries with no properties looped for minutes). A matching grid still reads as
+// an organized cloud.
+TEST_F(CloudIo, CraftedPlyHeadersAreRefused) {
+  std::string grid;
+  for (int i = 0; i < 120; ++i) grid += "1 " + std::to_string(i == 5 ? -1 : i) + "\n";
+  expect_rejected(file("rg.ply", crafted_ply(120, "obj_info num_cols 12\nobj_info num_rows 10\n",
+                                             "element range_grid 120\nproperty list uchar int "
+                                             "vertex_indices\n",
+                                             grid)),
+                  "range_grid elements are not read");
+  expect_rejected(file("one.ply", crafted_ply(120, "obj_info num_cols 1\nobj_info num_rows 1\n")),
+                  "grid 1 x 1 does not hold its 120 vertices");
+  expect_rejected(
+      file("big.ply", crafted_ply(120, "obj_info num_cols 2000\nobj_info num_rows 2000\n")),
+      "grid 2000 x 2000 does not hold");
+  expect_rejected(file("half.ply", crafted_ply(120, "obj_info num_cols 12\n")),
+                  "num_cols without num_rows");
+  expect_rejected(file("junk.ply", crafted_ply(120, "", "element junk 18446744073709551615\n")),
+                  "without properties declares 18446744073709551615 entries");
+  const Cloud grid_ok = read_cloud(
+      file("ok.ply", crafted_ply(120, "obj_info num_cols 12\nobj_info num_rows 10\n")).string());
+  EXPECT_EQ(grid_ok.count_valid(), 120u);
+}
+
 TEST_F(CloudIo, FailuresPrintNothing) {
   // PCL would print its own multi-line errors; the caller's one line must be all there is.
   const fs::path cut = dir_ / "cut.ply";

@@ -23,23 +23,57 @@ std::uint64_t ply_type_size(std::string_view t) {
   return 0;
 }
 
-// The least number of data bytes the header's elements take, summed as the header is read.
+// The least number of data bytes the header's elements take, summed as the header is read,
+// and what PCL would build an organized grid from.
 struct PlyBodySize {
   bool ascii = true;
   std::uint64_t min_body = 0, element_min = 0, element_count = 0;
+  std::uint64_t file_size = 0, vertices = 0, cols = 0, rows = 0;
+  bool has_cols = false, has_rows = false;
 
   void close_element() {
+    // An element with no properties takes no data bytes; its entries are still looped over
+    // (2^64 - 1 of them kept PCL's reader busy for minutes).
+    if (element_min == 0 && element_count > file_size) {
+      reject("malformed PLY header: an element without properties declares " +
+             std::to_string(element_count) + " entries, more than the file's " +
+             std::to_string(file_size) + " bytes");
+    }
     min_body += checked_mul(element_count, element_min, "an element count");
     if (min_body > kMaxDataBytes) reject("element counts are too large");
     element_min = element_count = 0;
   }
 };
 
+// PCL builds an organized cloud of obj_info's num_cols x num_rows points and fills it from
+// the vertices: a grid that is not the vertices' own shape tripped an assertion in its
+// reader (1 x 1 for 120 vertices: exit 134) or made a cloud of millions of empty points
+// (2000 x 2000 from a 176-byte file). Returns false (not end_header).
+bool parse_obj_info(const std::vector<std::string_view>& tokens, int line_no, PlyBodySize& body) {
+  if (tokens.size() < 2 || (tokens[1] != "num_cols" && tokens[1] != "num_rows")) return false;
+  const bool cols = tokens[1] == "num_cols";
+  if (tokens.size() != 3 || !parse_u64(tokens[2], cols ? body.cols : body.rows)) {
+    reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad obj_info line");
+  }
+  (cols ? body.has_cols : body.has_rows) = true;
+  return false;
+}
+
+// range_grid elements, whose vertex indices PCL writes through unchecked (an index of -1
+// crashed it), are not read.
+void check_element(std::string_view name, PlyBodySize& body) {
+  if (name == "range_grid") {
+    reject("PLY range_grid elements are not read (save organized scans as PCD)");
+  }
+  if (name == "vertex") body.vertices = body.element_count;
+}
+
 // One header line after the magic; returns true at end_header.
 bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bool& seen_format,
                     PlyBodySize& body) {
   const std::string_view key = tokens[0];
-  if (key == "comment" || key == "obj_info") return false;
+  if (key == "comment") return false;
+  if (key == "obj_info") return parse_obj_info(tokens, line_no, body);
   if (key == "format") {
     if (tokens.size() != 3 || (tokens[1] != "ascii" && tokens[1] != "binary_little_endian" &&
                                tokens[1] != "binary_big_endian")) {
@@ -52,6 +86,7 @@ bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bo
     if (tokens.size() != 3 || !parse_u64(tokens[2], body.element_count)) {
       reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad element line");
     }
+    check_element(tokens[1], body);
   } else if (key == "property") {
     const bool list = tokens.size() == 5 && tokens[1] == "list";
     const std::uint64_t size =
@@ -79,6 +114,7 @@ void check_ply_structure(const std::string& content) {
   int line_no = 0;
   bool seen_format = false, seen_end = false;
   PlyBodySize body;
+  body.file_size = content.size();
   while (!seen_end && pos < content.size()) {
     const auto tokens = split_ws(next_line(content, pos));
     ++line_no;
@@ -91,6 +127,11 @@ void check_ply_structure(const std::string& content) {
   }
   if (!seen_end) reject("malformed PLY header: no end_header line");
   if (!seen_format) reject("malformed PLY header: no format line");
+  if (body.has_cols != body.has_rows) reject("malformed PLY header: num_cols without num_rows");
+  if (body.has_cols && checked_mul(body.cols, body.rows, "a grid size") != body.vertices) {
+    reject("PLY obj_info grid " + std::to_string(body.cols) + " x " + std::to_string(body.rows) +
+           " does not hold its " + std::to_string(body.vertices) + " vertices");
+  }
   const std::uint64_t have = content.size() - pos;
   // The last ASCII value may end the file without a separator.
   const std::uint64_t need = body.ascii && body.min_body > 0 ? body.min_body - 1 : body.min_body;
