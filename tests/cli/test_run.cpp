@@ -113,6 +113,39 @@ TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   EXPECT_EQ(moves, poses.size() - 1);  // every waypoint after the first is a movep
 }
 
+// The same scan and parameters give byte-identical outputs whatever the thread count, for
+// both methods and on the default backend too; report.json differs only in its timings and
+// the device line (which names the thread count).
+TEST_F(CliRun, OutputsAreTheSameForEveryThreadCount) {
+  for (const std::string flags :
+       {"--method robust --backend cpu", "--method robust", "--method paper --backend cpu"}) {
+    SCOPED_TRACE(flags);
+    std::vector<fs::path> outs;
+    for (const char* threads : {"1", "2"}) {
+      outs.push_back(dir_ / (std::string("out") + threads));
+      fs::remove_all(outs.back());
+      const auto r =
+          test::run_cli("run " + scan_.string() + " -o " + outs.back().string() + " -q " + flags,
+                        dir_, std::string("OMP_NUM_THREADS=") + threads);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    for (const auto& entry : fs::directory_iterator(outs[0])) {
+      const std::string name = entry.path().filename().string();
+      const std::string a = test::read_text(entry.path()), b = test::read_text(outs[1] / name);
+      if (name != "report.json") {
+        EXPECT_TRUE(a == b) << name << " differs between 1 and 2 threads";
+        continue;
+      }
+      nlohmann::json ja = nlohmann::json::parse(a), jb = nlohmann::json::parse(b);
+      for (auto* j : {&ja, &jb}) {
+        j->erase("timings_ms");
+        j->erase("device");
+      }
+      EXPECT_EQ(ja, jb) << "report.json differs beyond timings and device";
+    }
+  }
+}
+
 TEST_F(CliRun, FlagsOverrideConfigAndReportRecordsThem) {
   const fs::path out = dir_ / "out_cfg";
   const fs::path cfg = dir_ / "cfg.yaml";
