@@ -172,6 +172,27 @@ TEST(RobustTrajectory, BlendingLeavesAStraightSeamsOrientation) {
   EXPECT_LT(max_rotation_rate(b).deg_per_mm, 1e-6);
 }
 
+// A straight seam whose first two sections read their bisector 20 deg off (a noisy seam end):
+// near the end the blend window runs one-sided rather than shrinking to the end root alone,
+// so the torch does not swing through those 20 deg within the first millimetre (it turned
+// 18 deg/mm at a 640x480 seam's start).
+TEST(RobustTrajectory, ANoisyEndDoesNotSwingTheTorch) {
+  SeamCandidate s;
+  const Eigen::Vector3d down(0, 0, -1);
+  const Eigen::Vector3d off(0, std::sin(20 * M_PI / 180), -std::cos(20 * M_PI / 180));
+  for (int k = 0; k <= 100; ++k) {
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(-0.075 + 0.0015 * k, 0.0, 0.4);
+    g.tangent = Eigen::Vector3d(1, 0, 0);
+    g.normal = g.bisector = k < 2 ? off : down;
+    s.sections.push_back(g);
+  }
+  s.accepted = true;
+  const Trajectory t = seam_trajectory(s, RobustParams{});  // orientation_blend 25 mm
+  EXPECT_LT(max_rotation_rate(t).deg_per_mm, 3.0);  // 1.1; 5.9 with the window shrunk to the end
+}
+
 // An L whose corner point lies 1 mm beyond the second leg (its lines and the first leg's meet
 // there, its roots run 1 mm short of it): the path does not go out to the corner and back.
 TEST(RobustTrajectory, ACornerThatFoldsBackIsCut) {
