@@ -44,6 +44,12 @@ struct GT_API Cloud {
 /// integers the grids index with (a point at 1e8 m crashed the OpenCL crease kernel).
 constexpr double kMaxCoordinate = 1000.0;
 
+/// Whether a point lies beyond +-kMaxCoordinate in any coordinate (an infinity does, NaN not).
+inline bool beyond_max_coordinate(float x, float y, float z) {
+  return std::abs(x) > kMaxCoordinate || std::abs(y) > kMaxCoordinate ||
+         std::abs(z) > kMaxCoordinate;
+}
+
 /// Throws InputError (exit 3) naming the first valid point of `cloud` with a coordinate beyond
 /// +-kMaxCoordinate, and how many there are. Every entry that grids a cloud calls it: the
 /// readers, detect_robust and the backends.

@@ -1,5 +1,6 @@
 // The range check every cloud passes before it is gridded (groovetrace/cloud.hpp).
 
+#include <algorithm>
 #include <cmath>
 #include <groovetrace/cloud.hpp>
 #include <groovetrace/error.hpp>
@@ -12,12 +13,10 @@ void require_in_range(const Cloud& cloud) {
   std::size_t beyond = 0, first = 0;
   double value = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const double m = std::max({std::abs(cloud.x[i]), std::abs(cloud.y[i]), std::abs(cloud.z[i])});
-    // NaN (an invalid return) compares false and passes; an infinity does not.
-    if (!(m > kMaxCoordinate)) continue;
+    if (!beyond_max_coordinate(cloud.x[i], cloud.y[i], cloud.z[i])) continue;
     if (beyond++ == 0) {
       first = i;
-      value = m;
+      value = std::max({std::abs(cloud.x[i]), std::abs(cloud.y[i]), std::abs(cloud.z[i])});
     }
   }
   if (beyond == 0) return;

@@ -48,15 +48,14 @@ struct PlyBodySize {
 // PCL builds an organized cloud of obj_info's num_cols x num_rows points and fills it from
 // the vertices: a grid that is not the vertices' own shape tripped an assertion in its
 // reader (1 x 1 for 120 vertices: exit 134) or made a cloud of millions of empty points
-// (2000 x 2000 from a 176-byte file). Returns false (not end_header).
-bool parse_obj_info(const std::vector<std::string_view>& tokens, int line_no, PlyBodySize& body) {
-  if (tokens.size() < 2 || (tokens[1] != "num_cols" && tokens[1] != "num_rows")) return false;
+// (2000 x 2000 from a 176-byte file).
+void parse_obj_info(const std::vector<std::string_view>& tokens, int line_no, PlyBodySize& body) {
+  if (tokens.size() < 2 || (tokens[1] != "num_cols" && tokens[1] != "num_rows")) return;
   const bool cols = tokens[1] == "num_cols";
   if (tokens.size() != 3 || !parse_u64(tokens[2], cols ? body.cols : body.rows)) {
     reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad obj_info line");
   }
   (cols ? body.has_cols : body.has_rows) = true;
-  return false;
 }
 
 // range_grid elements, whose vertex indices PCL writes through unchecked (an index of -1
@@ -73,7 +72,10 @@ bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bo
                     PlyBodySize& body) {
   const std::string_view key = tokens[0];
   if (key == "comment") return false;
-  if (key == "obj_info") return parse_obj_info(tokens, line_no, body);
+  if (key == "obj_info") {
+    parse_obj_info(tokens, line_no, body);
+    return false;
+  }
   if (key == "format") {
     if (tokens.size() != 3 || (tokens[1] != "ascii" && tokens[1] != "binary_little_endian" &&
                                tokens[1] != "binary_big_endian")) {

@@ -59,7 +59,7 @@ Cloud to_cloud(const Decoded& decoded, double scale, std::size_t min_valid) {
     // Coordinates beyond float range become inf here and are rejected with the infinities.
     if (std::isinf(v[0]) || std::isinf(v[1]) || std::isinf(v[2])) {
       ++infinite;
-    } else if (std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}) > kMaxCoordinate) {
+    } else if (beyond_max_coordinate(v[0], v[1], v[2])) {
       ++beyond;
     }
     // A point missing any coordinate is no point at all; downstream tests x alone.

@@ -5,11 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <groovetrace/cloud.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/frames.hpp>
@@ -29,13 +25,6 @@ namespace {
   std::replace_if(
       line.begin(), line.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
   throw InputError(line);
-}
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
 }
 
 // Regular files only (a FIFO hung the read), nested no deeper than the parsers can take.
@@ -113,7 +102,7 @@ std::vector<double> json_numbers(const std::string& path, const nlohmann::json& 
 }  // namespace
 
 Eigen::Isometry3d read_transform(const std::string& path) {
-  const std::string ext = lower_extension(path);
+  const std::string ext = io::lower_extension(path);
   const bool yaml = ext == ".yaml" || ext == ".yml";
   if (!yaml && ext != ".json") {
     fail(path, (ext.empty() ? std::string("transform file has no extension")

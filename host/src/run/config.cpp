@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <limits>
@@ -324,16 +323,15 @@ std::string shown_key(const YAML::Node& key) {
 }  // namespace
 
 std::vector<std::string> apply_config_file(Params& params, const std::string& path) {
-  std::stringstream buf;
-  buf << io::read_all(path, true);
-  io::require_shallow(buf.str(), path);
+  const std::string text = io::read_all(path, true);
+  io::require_shallow(text, path);
   std::vector<std::pair<std::string, std::string>> entries;
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   if (ext == ".json") {
     nlohmann::json j;
     try {
-      j = nlohmann::json::parse(buf.str());
+      j = nlohmann::json::parse(text);
     } catch (const std::exception& e) {
       throw InputError("config file " + path + " is not valid JSON");
     }
@@ -352,7 +350,7 @@ std::vector<std::string> apply_config_file(Params& params, const std::string& pa
   } else if (ext == ".yaml" || ext == ".yml") {
     YAML::Node root;
     try {
-      root = YAML::Load(buf.str());
+      root = YAML::Load(text);
     } catch (const std::exception& e) {
       throw InputError("config file " + path + " is not valid YAML");
     }

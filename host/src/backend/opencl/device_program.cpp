@@ -99,9 +99,9 @@ cl::Device select_device(const std::string& selector) {
   const bool numeric = std::all_of(selector.begin(), selector.end(),
                                    [](unsigned char c) { return std::isdigit(c) != 0; });
   if (numeric) {
-    // Compared as text first: stoul throws on an index past its range (exit 5, "stoul").
-    const bool small = selector.size() <= 9;
-    if (small && std::stoul(selector) < devices.size()) return devices[std::stoul(selector)];
+    // At most 9 digits: stoul throws on an index past its range (exit 5, "stoul").
+    const unsigned long k = selector.size() <= 9 ? std::stoul(selector) : devices.size();
+    if (k < devices.size()) return devices[k];
     throw UsageError("device: no OpenCL device " + selector + " (devices: " + list + ")");
   }
   for (const auto& d : devices) {
