@@ -71,11 +71,14 @@ void require_affordable(const Cloud& cloud, double radius) {
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!cloud.valid(i)) continue;
     ++valid;
-    // Coordinates lie within kMaxCoordinate (require_in_range), so 21 bits per axis hold any
-    // cell of a millimetre or more; wrapping beyond only merges far cells, which overcounts.
+    // Coordinates lie within kMaxCoordinate (require_in_range), so a cell index fits an int64
+    // (a negative double cast straight to an unsigned integer is undefined); 21 bits per axis
+    // hold any cell of a millimetre or more, and wrapping beyond only merges far cells, which
+    // overcounts.
     std::uint64_t key = 0;
     for (const float c : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
-      key = (key << 21) ^ (static_cast<std::uint64_t>(std::floor(c / radius)) & 0x1FFFFF);
+      const auto cell = static_cast<std::int64_t>(std::floor(c / radius));
+      key = (key << 21) ^ (static_cast<std::uint64_t>(cell) & 0x1FFFFF);
     }
     ++cells[key];
   }
