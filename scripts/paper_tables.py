@@ -23,6 +23,7 @@ import math
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 import time
@@ -192,11 +193,10 @@ def run_one(binary, backend, scan, truth, seed, out, shape, method):
     Returns (method name as reported, entry)."""
     tag = method or "default"
     rdir = os.path.join(out, "runs", f"{shape}-{seed}", tag)
-    os.makedirs(rdir, exist_ok=True)
-    for stale in ("annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
-                  "report.json", "metrics.json", "program.script"):
-        if os.path.exists(os.path.join(rdir, stale)):
-            os.remove(os.path.join(rdir, stale))
+    # The run replaces rdir whole and refuses one holding files it does not write (the logs
+    # below): each run starts from an empty directory.
+    shutil.rmtree(rdir, ignore_errors=True)
+    os.makedirs(rdir)
     cmd = [binary, "run", scan, "-o", rdir, "--backend", backend, "-q"]
     if method is not None:
         cmd += ["--method", method]

@@ -37,6 +37,7 @@ import math
 import os
 import random
 import shlex
+import shutil
 import struct
 import subprocess
 import sys
@@ -253,6 +254,9 @@ def union_coverage(truth_path, csvs):
 
 
 def one_run(binary, method, scan, out, shape, extra=()):
+    # A run replaces OUTDIR whole and refuses one holding files it does not write (the
+    # camera_frame/ copy below): each run starts from an empty directory.
+    shutil.rmtree(out, ignore_errors=True)
     argv = [binary, "run", scan, "-o", out, "-q", "--method", method] + list(extra)
     if method == "robust" and shape == "multi":
         argv += ["--max-seams", "2"]

@@ -1,10 +1,7 @@
 // `groovetrace run SCAN -o OUTDIR`: the whole pipeline on one scan.
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <future>
 #include <groovetrace/cloud_io.hpp>
 #include <groovetrace/config.hpp>
@@ -20,38 +17,16 @@
 namespace groovetrace::cli {
 namespace {
 
-namespace fs = std::filesystem;
-
 struct RunOptions {
   std::string scan, out_dir;
   bool quiet = false;
   std::shared_ptr<ParamFlags> params = std::make_shared<ParamFlags>();
 };
 
-// Fails before any work if OUTDIR cannot be created or written, so a long run is not lost.
-void check_output_dir(const std::string& dir) {
-  // An empty path has no absolute form (std::filesystem threw: exit 5, "internal").
-  if (dir.empty()) throw UsageError("-o: the output directory is an empty path");
-  fs::path p = fs::absolute(dir);
-  std::error_code ec;
-  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) {
-    throw InputError("output path " + dir + " exists and is not a directory");
-  }
-  while (!fs::exists(p, ec)) p = p.parent_path();
-  if (!fs::is_directory(p, ec)) {
-    throw InputError("cannot create output directory " + dir + ": " + p.string() +
-                     " is not a directory");
-  }
-  if (::access(p.c_str(), W_OK) != 0) {
-    throw InputError("output directory " + dir + " is not writable");
-  }
-}
-
-int run(const RunOptions& opt) {
+int run_checked(const RunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> param_warnings;
   const Params params = parse_params(*opt.params, param_warnings);
-  check_output_dir(opt.out_dir);
   auto say = [&](const char* fmt, auto... args) {
     if (!opt.quiet) {
       std::printf(fmt, args...);
@@ -101,6 +76,20 @@ int run(const RunOptions& opt) {
   for (const auto& f : files) say(" %s", f.first.c_str());
   say("\n");
   return 0;
+}
+
+// OUTDIR is checked before any work, so a long run is not lost to it; once it is, any failure
+// replaces the earlier outputs by a report.json that says why (no stale program stays).
+int run(const RunOptions& opt) {
+  check_output_dir(opt.out_dir);
+  try {
+    return run_checked(opt);
+  } catch (const std::exception& e) {
+    const auto* error = dynamic_cast<const Error*>(&e);
+    write_failure_report(opt.out_dir, opt.scan, error ? error->code() : ExitCode::kInternal,
+                         e.what());
+    throw;
+  }
 }
 
 }  // namespace

@@ -6,8 +6,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace groovetrace::test {
 
@@ -50,6 +52,31 @@ inline CliResult run_cli_command(const std::string& command, const std::filesyst
 inline CliResult run_cli(const std::string& args, const std::filesystem::path& scratch,
                          const std::string& env = "") {
   return run_cli_command(env + " " + std::string(GT_CLI_PATH) + " " + args, scratch);
+}
+
+/// The names in a directory, sorted; hidden ones too.
+inline std::vector<std::string> entries(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+/// The contract of a `run -o out` that failed after checking `out`: out holds report.json
+/// alone, with the exit code and the message stderr showed, and nothing else is left beside
+/// out (no temporaries). `err` is the run's stderr.
+inline void expect_failure_report(const std::filesystem::path& out, int code,
+                                  const std::string& err) {
+  ASSERT_EQ(entries(out), std::vector<std::string>{"report.json"});
+  const auto report = nlohmann::json::parse(read_text(out / "report.json"));
+  EXPECT_EQ(report["exit_code"], code);
+  EXPECT_EQ(report["status"], code == 3 ? "invalid_input" : code == 4 ? "no_groove" : "error");
+  EXPECT_EQ(err.rfind("groovetrace: error: " + report["message"].get<std::string>(), 0), 0u) << err;
+  for (const auto& name : entries(out.parent_path())) {
+    EXPECT_EQ(name.find(".groovetrace-"), std::string::npos) << "left behind: " << name;
+  }
 }
 
 }  // namespace groovetrace::test

@@ -11,6 +11,21 @@ namespace groovetrace {
 /// groove, 5 internal.
 enum class ExitCode : int { kOk = 0, kUsage = 2, kInput = 3, kNoGroove = 4, kInternal = 5 };
 
+/// The status word of an exit code in report.json and batch summaries: ok, invalid_input,
+/// no_groove, or error (bad usage, internal).
+inline const char* status_name(ExitCode code) {
+  switch (code) {
+    case ExitCode::kOk:
+      return "ok";
+    case ExitCode::kInput:
+      return "invalid_input";
+    case ExitCode::kNoGroove:
+      return "no_groove";
+    default:
+      return "error";
+  }
+}
+
 /// Base of every error groovetrace throws on purpose; what() is one line, fit for stderr.
 class GT_API Error : public std::runtime_error {
  public:

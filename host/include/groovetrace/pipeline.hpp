@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <groovetrace/cloud.hpp>
+#include <groovetrace/error.hpp>
 #include <groovetrace/export.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/paper.hpp>
@@ -71,8 +72,24 @@ GT_API std::vector<std::pair<std::string, std::string>> render_outputs(
     const Cloud& input, const RunResult& result, const Params& params,
     const std::string& input_path, double total_ms);
 
-/// Writes each rendered file into `out_dir` atomically (creating the directory).
+/// True for the names a run writes into its output directory (render_outputs'), which is
+/// what an existing OUTDIR may hold for a run to replace it.
+GT_API bool is_run_output(const std::string& name);
+
+/// Throws unless `out_dir` can take a run's outputs: UsageError for an empty path; InputError
+/// when it is a file, holds a file a run does not write, or its folder is not writable.
+GT_API void check_output_dir(const std::string& out_dir);
+
+/// Replaces the directory `out_dir` by one holding exactly `files`, as one set: a reader, a
+/// kill or a full disk leaves the earlier run's set or this one, never a mix (the set is built
+/// beside `out_dir` and swapped in; docs/design.md, "CLI contract").
 GT_API void write_outputs(const std::string& out_dir,
                           const std::vector<std::pair<std::string, std::string>>& files);
+
+/// Replaces `out_dir`'s outputs by report.json alone with the failure's status, exit code and
+/// one-line message, so no earlier program stays behind a failed run. If even that cannot be
+/// written, removes the earlier outputs. Never throws.
+GT_API void write_failure_report(const std::string& out_dir, const std::string& input_path,
+                                 ExitCode code, const std::string& message);
 
 }  // namespace groovetrace

@@ -26,17 +26,6 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-const char* status_of(ExitCode code) {
-  switch (code) {
-    case ExitCode::kInput:
-      return "invalid_input";
-    case ExitCode::kNoGroove:
-      return "no_groove";
-    default:
-      return "error";
-  }
-}
-
 // The counts of a finished run.
 void fill_counts(ScanRow& row, const Cloud& cloud, const RunResult& result) {
   row.points = cloud.size();
@@ -115,7 +104,7 @@ ScanRow run_scan(const ScanJob& job, const Params& batch_params, FeatureBackend&
     files = run_files(job, p, backend, row);
     row.status = "ok";
   } catch (const Error& e) {
-    row.status = status_of(e.code());
+    row.status = status_name(e.code());
     row.exit_code = static_cast<int>(e.code());
     row.message = e.what();
     files.clear();

@@ -1,5 +1,5 @@
 // The files of a run: annotated cloud, overview picture, trajectories, robot programs and
-// report.json, rendered as bytes first and then each written atomically.
+// report.json, rendered as bytes first and then written as one set (io/output_dir.hpp).
 
 #include <cmath>
 #include <filesystem>
@@ -9,8 +9,11 @@
 #include <groovetrace/pipeline.hpp>
 #include <groovetrace/trajectory_io.hpp>
 #include <groovetrace/urscript.hpp>
+#include <groovetrace/version.hpp>
 #include <nlohmann/json.hpp>
+#include <regex>
 
+#include "io/output_dir.hpp"
 #include "picture/overview.hpp"
 #include "run/overview.hpp"
 
@@ -168,8 +171,17 @@ json points_report(const Cloud& input, const RunResult& result) {
           {"groove", groove}};
 }
 
+// report.json "outputs": the other files of the set with their sizes, so a reader can tell
+// that the files beside it are the ones this run wrote.
+json outputs_json(const std::vector<std::pair<std::string, std::string>>& files) {
+  json out = json::array();
+  for (const auto& [name, bytes] : files) out.push_back({{"file", name}, {"bytes", bytes.size()}});
+  return out;
+}
+
 std::string report_json(const Cloud& input, const RunResult& result, const Params& params,
-                        const std::string& input_path, double total_ms) {
+                        const std::string& input_path, double total_ms,
+                        const std::vector<std::pair<std::string, std::string>>& files) {
   json timings = json::object();
   for (const auto& [stage, ms] : result.timings_ms) timings[stage] = ms;
   timings["total"] = total_ms;
@@ -179,6 +191,9 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   add_rotation_rate(trajectory, &best);
   json report = {{"version", version()},
                  {"input", input_path},
+                 {"status", status_name(ExitCode::kOk)},
+                 {"exit_code", 0},
+                 {"outputs", outputs_json(files)},
                  {"method", to_string(result.method)},
                  {"backend", result.backend},
                  {"device", result.device},
@@ -230,20 +245,62 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
     files.emplace_back("trajectory" + n + ".json", trajectory_json(t, params));
     files.emplace_back("program" + n + ".script", urscript_program(t, params.program));
   }
-  files.emplace_back("report.json", report_json(input, result, params, input_path, total_ms));
+  files.emplace_back("report.json",
+                     report_json(input, result, params, input_path, total_ms, files));
   return files;
+}
+
+bool is_run_output(const std::string& name) {
+  // The files render_outputs and write_failure_report make, eval's metrics.json (it scores
+  // them), and the temporaries of an earlier version's per-file writes (.NAME.XXXXXXXX.tmp).
+  static const std::regex kOutput(
+      R"(annotated\.pcd|overview\.png|report\.json|metrics\.json|trajectory(_[0-9]+)?\.(csv|json)|)"
+      R"(program(_[0-9]+)?\.script|\..+\.[A-Za-z0-9]{8}\.tmp)");
+  return std::regex_match(name, kOutput);
+}
+
+void check_output_dir(const std::string& out_dir) {
+  // An empty path has no absolute form (std::filesystem threw: exit 5, "internal").
+  if (out_dir.empty()) throw UsageError("-o: the output directory is an empty path");
+  io::check_replaceable(out_dir, is_run_output);
 }
 
 void write_outputs(const std::string& out_dir,
                    const std::vector<std::pair<std::string, std::string>>& files) {
+  io::replace_directory(out_dir, files, is_run_output);
+}
+
+namespace {
+
+// Programs first: a reader that looks in between finds no program.
+void remove_outputs(const std::string& out_dir) noexcept {
   std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec || !std::filesystem::is_directory(out_dir)) {
-    throw InputError("cannot create output directory " + out_dir +
-                     (ec ? ": " + ec.message() : ": not a directory"));
+  for (const char* first : {"program", ""}) {
+    try {
+      for (const auto& e : std::filesystem::directory_iterator(out_dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (is_run_output(name) && name.rfind(first, 0) == 0) std::filesystem::remove(e.path(), ec);
+      }
+    } catch (...) {  // an entry that vanished while we listed: the next pass sees the rest
+    }
   }
-  for (const auto& [name, bytes] : files) {
-    write_file_atomic((std::filesystem::path(out_dir) / name).string(), bytes);
+}
+
+}  // namespace
+
+void write_failure_report(const std::string& out_dir, const std::string& input_path, ExitCode code,
+                          const std::string& message) {
+  const json report = {{"version", version()},        {"input", input_path},
+                       {"status", status_name(code)}, {"exit_code", static_cast<int>(code)},
+                       {"message", message},          {"outputs", json::array()}};
+  try {
+    // Replaced, not refused: a path's bytes that are not UTF-8 must not cost the report.
+    const std::string text = report.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+    write_outputs(out_dir, {{"report.json", text}});
+  } catch (...) {
+    // No room even for the report (a full disk): at least no earlier program stays behind
+    // to be run as this run's.
+    remove_outputs(out_dir);
   }
 }
 
