@@ -136,6 +136,16 @@ TEST_F(OutputSet, ARerunLeavesOnlyItsOwnFiles) {
   EXPECT_FALSE(temporaries_beside(out_));
 }
 
+// The new set's directory takes the permissions the user gave the old one.
+TEST_F(OutputSet, ARerunKeepsTheDirectorysPermissions) {
+  ASSERT_EQ(run('A').exit_code, 0);
+  fs::permissions(out_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                            fs::perms::others_exec);
+  const auto before = fs::status(out_).permissions();
+  ASSERT_EQ(run('B').exit_code, 0);
+  EXPECT_EQ(fs::status(out_).permissions(), before);
+}
+
 // A failed rerun replaces the earlier set by its report.json: no earlier program stays to be
 // taken for this run's.
 TEST_F(OutputSet, AFailedRerunLeavesOnlyItsReport) {

@@ -119,7 +119,10 @@ void require_ours(const fs::path& target, const NamePredicate& ours) {
 }
 
 // Moves `built` to `target`; returns where the target's old content now is ("" if none).
+// The target keeps its permissions (a group-writable folder stays one).
 fs::path swap_in(const fs::path& built, const fs::path& target) {
+  struct stat old_mode {};
+  if (::stat(target.c_str(), &old_mode) == 0) ::chmod(built.c_str(), old_mode.st_mode & 07777);
   if (::renameat2(AT_FDCWD, built.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) == 0) {
     return built;
   }
