@@ -8,6 +8,8 @@
 #include <groovetrace/opencl.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "support/cli_runner.hpp"
 #include "support/scenes.hpp"
@@ -88,6 +90,53 @@ TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
   EXPECT_NE(test::read_text(log).find("VW must be"), std::string::npos) << log;
   EXPECT_EQ(test::read_text(victim), "keep me\n");
   test::expect_failure_report(out, 5, r.err.substr(r.err.find("groovetrace: error: ")));
+}
+
+// The same build failure under `--backend auto` (the default): the run goes on on the CPU,
+// exit 0, with the reason as a warning on stderr and in report.json.
+TEST_F(CliBackend, KernelBuildFailureUnderAutoFallsBackToCpu) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const std::string env = "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend auto --method paper -q", dir_,
+      env);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream lines(r.err);
+  std::vector<std::string> ours;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("groovetrace:", 0) == 0) ours.push_back(line);
+  }
+  ASSERT_EQ(ours.size(), 1u) << r.err;
+  EXPECT_EQ(ours[0].rfind("groovetrace: warning: OpenCL unavailable, using the cpu backend: ", 0),
+            0u)
+      << r.err;
+  EXPECT_NE(ours[0].find("failed to build"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["exit_code"], 0);
+  EXPECT_EQ(report["backend"], "cpu");
+  ASSERT_FALSE(report["warnings"].empty());
+  EXPECT_NE(report["warnings"][0].get<std::string>().find("failed to build"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "program.script"));
+}
+
+// Failure 9: on a cold PoCL kernel cache, PoCL's compiler printed "333 warnings generated." on
+// stderr past -q (-Wpsabi on every float16 argument, on a CPU without AVX-512). This CPU may
+// draw none, so one warning is injected: kernels/common.cl defines GT_CAT_ again ("macro
+// redefined") and keeps its own definition, so the kernels are unchanged.
+TEST_F(CliBackend, ColdKernelCacheBuildPrintsNothingWithQuiet) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path cache = dir_ / "pocl-cache", out = dir_ / "out";
+  fs::create_directories(cache);
+  const auto r =
+      test::run_cli("run " + scan_.string() + " -o " + out.string() + " -q", dir_,
+                    "POCL_CACHE_DIR=" + cache.string() + " GROOVETRACE_OPENCL_OPTIONS=-DGT_CAT_");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out, "");
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "opencl");
+  EXPECT_FALSE(fs::is_empty(cache)) << "the kernels were not compiled into the fresh cache";
 }
 
 TEST_F(CliBackend, UnknownDeviceIsAUsageError) {

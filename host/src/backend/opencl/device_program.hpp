@@ -40,7 +40,8 @@ cl::Device select_device(const std::string& selector);
 
 /// The program for `device`, built on first use and kept for the life of the process.
 /// Throws OpenClError carrying the build log when the kernels do not compile. Build options
-/// are -DVW (see vector_width_for), -DPAD, and GROOVETRACE_OPENCL_OPTIONS when set.
+/// are -w (no warnings), -DVW (see vector_width_for), -DPAD, and GROOVETRACE_OPENCL_OPTIONS
+/// when set.
 std::shared_ptr<const DeviceProgram> program_for(const cl::Device& device);
 
 }  // namespace groovetrace::ocl
