@@ -23,6 +23,16 @@ namespace fs = std::filesystem;
 // means no OpenCL platform at all, as on a machine without a driver.
 const char* kNoOpenCl = "OCL_ICD_VENDORS=/nonexistent-groovetrace-icd";
 
+// A platform that exists but lists no device: an ICD directory holding only PoCL, whose
+// POCL_DEVICES names a driver this PoCL does not have (cuda), so it finds no device. Returns
+// the environment for run_cli.
+std::string pocl_without_devices(const fs::path& dir) {
+  const fs::path vendors = dir / "icd";
+  fs::create_directories(vendors);
+  std::ofstream(vendors / "pocl.icd") << "libpocl.so.2\n";
+  return "OCL_ICD_VENDORS=" + vendors.string() + " POCL_DEVICES=cuda";
+}
+
 class CliBackend : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -57,6 +67,36 @@ TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
+  test::expect_failure_report(out, 5, r.err);
+}
+
+// No device, but a platform: auto runs on the CPU and says why; opencl is exit 5, one line
+// that names the platform, and OUTDIR holds only report.json.
+TEST_F(CliBackend, PlatformWithoutDeviceFallsBackUnderAuto) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " -q", dir_,
+                               pocl_without_devices(dir_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err,
+            "groovetrace: warning: OpenCL unavailable, using the cpu backend: no OpenCL device "
+            "found: the platform Portable Computing Language lists no device\n");
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["backend"], "cpu");
+  ASSERT_FALSE(report["warnings"].empty());
+  EXPECT_NE(report["warnings"][0].get<std::string>().find("lists no device"), std::string::npos);
+}
+
+TEST_F(CliBackend, PlatformWithoutDeviceFailsExplicitOpenCl) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const auto r =
+      test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_,
+                    pocl_without_devices(dir_));
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_EQ(r.err,
+            "groovetrace: error: no OpenCL device found: the platform Portable Computing Language "
+            "lists no device\n");
   test::expect_failure_report(out, 5, r.err);
 }
 

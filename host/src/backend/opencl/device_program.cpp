@@ -55,6 +55,30 @@ std::string first_error_line(const std::string& log) {
   return first.empty() ? "(empty build log)" : first;
 }
 
+// Why no device was found, for the one line: no platform at all (no driver installed), or
+// platforms that list no device (a driver without its hardware, or devices hidden from this
+// process, e.g. by POCL_DEVICES).
+std::string no_device_message() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    platforms.clear();
+  }
+  if (platforms.empty()) return "no OpenCL platform found (is an OpenCL driver installed?)";
+  std::string names;
+  for (const auto& p : platforms) {
+    try {
+      names += (names.empty() ? "" : ", ") + p.getInfo<CL_PLATFORM_NAME>();
+    } catch (const cl::Error&) {
+      names += (names.empty() ? "" : ", ") + std::string("(unnamed)");
+    }
+  }
+  const bool one = platforms.size() == 1;
+  return std::string("no OpenCL device found: the platform") + (one ? " " : "s ") + names +
+         (one ? " lists" : " list") + " no device";
+}
+
 std::mutex g_mutex;
 // Keyed by device and build options: a changed GROOVETRACE_OPENCL_* setting builds anew.
 std::map<std::pair<cl_device_id, std::string>, std::shared_ptr<const DeviceProgram>> g_programs;
@@ -84,8 +108,7 @@ std::vector<cl::Device> all_devices() {
 
 cl::Device select_device(const std::string& selector) {
   const std::vector<cl::Device> devices = all_devices();
-  if (devices.empty())
-    throw OpenClError("no OpenCL device found (is an OpenCL driver installed?)", 0);
+  if (devices.empty()) throw OpenClError(no_device_message(), 0);
   if (selector.empty()) {
     for (const auto& d : devices) {
       if (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) return d;
