@@ -179,6 +179,72 @@ TEST_F(CliBackend, ColdKernelCacheBuildPrintsNothingWithQuiet) {
   EXPECT_FALSE(fs::is_empty(cache)) << "the kernels were not compiled into the fresh cache";
 }
 
+// A cloud too large for the device's memory (lowered to 1 MiB by the backend's test hook; the
+// 320x240 scan needs about 9 MiB): an explicit `--backend opencl` is exit 5 with one line
+// naming both sizes and OUTDIR holding only report.json.
+const char* kOneMiB = "GROOVETRACE_OPENCL_MEMORY_LIMIT=1048576";
+
+TEST_F(CliBackend, CloudTooLargeForTheDeviceFailsExplicitOpenCl) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
+      kOneMiB);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("groovetrace: error: OpenCL device ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("has too little memory for 76800 points: needs up to "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("the device offers 1.0 MiB"), std::string::npos) << r.err;
+  test::expect_failure_report(out, 5, r.err);
+}
+
+// The same under `--backend auto`, with either method: the stage that found the cloud too
+// large runs on the CPU, and so does the rest; exit 0, one warning line, report.json says so.
+TEST_F(CliBackend, CloudTooLargeForTheDeviceFallsBackUnderAuto) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  for (const char* method : {"robust", "paper"}) {
+    const fs::path out = dir_ / (std::string("out-") + method);
+    const auto r = test::run_cli(
+        "run " + scan_.string() + " -o " + out.string() + " -q --method " + method, dir_, kOneMiB);
+    ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+    const std::string prefix = "groovetrace: warning: OpenCL failed, using the cpu backend: ";
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("too little memory"), std::string::npos) << r.err;
+    const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+    EXPECT_EQ(report["backend"], "cpu") << method;
+    ASSERT_FALSE(report["warnings"].empty()) << method;
+    EXPECT_EQ("groovetrace: warning: " + report["warnings"][0].get<std::string>() + "\n", r.err);
+    EXPECT_TRUE(fs::exists(out / "program.script")) << method;
+  }
+}
+
+// In a batch, a worker whose backend fell back on one scan sets it up anew for the next: a
+// scan that fits runs on the device again, without the other scan's warning. The limit (16
+// MiB) lies between the 640x480 scan's need (about 23 MiB) and the 320x240 one's (9 MiB).
+TEST_F(CliBackend, BatchGoesBackToTheDeviceAfterACloudTooLarge) {
+  if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path in = dir_ / "scans", out = dir_ / "batch";
+  fs::create_directories(in);
+  test::VGrooveScene big;
+  write_file_atomic((in / "a-big.pcd").string(), pcd_bytes(test::render_vgroove(big).cloud));
+  fs::copy_file(scan_, in / "b-small.pcd");
+  const auto r = test::run_cli(
+      "batch " + in.string() + " -o " + out.string() + " --jobs 1 --method paper --backend auto",
+      dir_, "GROOVETRACE_OPENCL_MEMORY_LIMIT=16777216");
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const auto a = nlohmann::json::parse(test::read_text(out / "a-big" / "report.json"));
+  EXPECT_EQ(a["backend"], "cpu");
+  ASSERT_FALSE(a["warnings"].empty());
+  EXPECT_NE(a["warnings"][0].get<std::string>().find("too little memory for 307200 points"),
+            std::string::npos)
+      << a["warnings"];
+  const auto b = nlohmann::json::parse(test::read_text(out / "b-small" / "report.json"));
+  EXPECT_EQ(b["backend"], "opencl");
+  EXPECT_TRUE(b["warnings"].empty()) << b["warnings"];
+}
+
 TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
   const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
                                    " --method paper --backend opencl --device no-such-device-name",

@@ -133,6 +133,22 @@ cl::Device select_device(const std::string& selector) {
   throw UsageError("device: no OpenCL device matches '" + selector + "' (devices: " + list + ")");
 }
 
+DeviceMemory device_memory(const cl::Device& device) {
+  DeviceMemory m;
+  m.global = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+  m.max_alloc = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  if (const char* env = std::getenv("GROOVETRACE_OPENCL_MEMORY_LIMIT")) {
+    char* end = nullptr;
+    const unsigned long long limit = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && limit > 0 && std::isdigit(static_cast<unsigned char>(*env))) {
+      m.global = std::min<std::uint64_t>(m.global, limit);
+      m.max_alloc = std::min<std::uint64_t>(m.max_alloc, limit);
+      m.limited = true;
+    }
+  }
+  return m;
+}
+
 std::shared_ptr<const DeviceProgram> program_for(const cl::Device& device) {
   const int vector_width = vector_width_for(device);
   // -w: a successful build prints nothing. PoCL's clang writes its count of warnings ("333
