@@ -8,29 +8,10 @@
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
 
+#include "support/opencl_support.hpp"
+
 namespace groovetrace {
 namespace {
-
-// Sets an environment variable for the life of the object.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old, had_ = true;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (had_) {
-      setenv(name_, old_.c_str(), 1);
-    } else {
-      unsetenv(name_);
-    }
-  }
-
- private:
-  const char* name_;
-  std::string old_;
-  bool had_ = false;
-};
 
 #define REQUIRE_DEVICES(devices)              \
   const auto devices = list_opencl_devices(); \
@@ -93,7 +74,8 @@ TEST(OpenClDevice, ProgramIsBuiltOncePerDevice) {
 // compiler's log; "auto" falls back to the CPU and says why.
 TEST(OpenClDevice, BuildFailureCarriesTheLogAndAutoFallsBack) {
   REQUIRE_DEVICES(devices);
-  const ScopedEnv bad("GROOVETRACE_OPENCL_OPTIONS", "-DVW=3");  // kernels/common.cl refuses it
+  const test::ScopedEnv bad("GROOVETRACE_OPENCL_OPTIONS",
+                            "-DVW=3");  // kernels/common.cl refuses it
   try {
     make_opencl_backend();
     FAIL() << "the build should fail";

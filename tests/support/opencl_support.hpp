@@ -1,7 +1,7 @@
 #pragma once
 // What the OpenCL tests share: the backend on the default device (or none), the same with one
 // query per work-item (the kernels' GPU form), the angle between two normals and a shuffled
-// copy of a cloud.
+// copy of a cloud, and an environment variable set for a scope.
 
 #include <gtest/gtest.h>
 
@@ -18,6 +18,29 @@
 #include <vector>
 
 namespace groovetrace::test {
+
+/// Sets an environment variable for the life of the object.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old, had_ = true;
+    setenv(name, value, 1);
+  }
+  ~ScopedEnv() {
+    if (had_) {
+      setenv(name_, old_.c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::string old_;
+  bool had_ = false;
+};
 
 /// The OpenCL backend on the default device; nullptr when there is none.
 inline std::unique_ptr<FeatureBackend> opencl_backend() {

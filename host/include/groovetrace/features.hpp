@@ -87,7 +87,9 @@ class GT_API FeatureBackend {
 GT_API Eigen::Vector3f benchmark_normal(const Normals& normals);
 
 /// Creates a backend by name: "cpu", "opencl" or "auto" (opencl when a device is present and
-/// the kernels build on it, else cpu with a warning() saying why). `device` picks the OpenCL
+/// the kernels build on it, else cpu with a warning() saying why; a call that fails on the
+/// device, e.g. a cloud too large for its memory, is rerun on the cpu, which then keeps the
+/// backend's later calls, and warning() says why). `device` picks the OpenCL
 /// device: an index into list_opencl_devices() or a name substring (see opencl.hpp); empty =
 /// the first GPU, else the first device. Throws UsageError for an unknown name or a device
 /// that matches nothing, OpenClError (an InternalError) when "opencl" cannot run.

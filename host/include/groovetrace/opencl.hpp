@@ -5,7 +5,9 @@
 // GROOVETRACE_OPENCL_PROFILE=1 prints each kernel's device time to stderr;
 // GROOVETRACE_OPENCL_SEARCH=grid uses the grid search for organized frames too;
 // GROOVETRACE_OPENCL_VW=1|2|4|8|16 sets the queries per work-item (default 16 on CPU devices,
-// 1 on GPUs); GROOVETRACE_OPENCL_OPTIONS adds OpenCL compiler options.
+// 1 on GPUs); GROOVETRACE_OPENCL_OPTIONS adds OpenCL compiler options;
+// GROOVETRACE_OPENCL_MEMORY_LIMIT=BYTES lowers the device memory the backend believes it has
+// (a test hook: a cloud too large for the device).
 
 #include <cstdint>
 #include <groovetrace/error.hpp>
@@ -65,7 +67,9 @@ GT_API OpenClMemory opencl_memory(bool reset_peak = false);
 /// first device; a number N = list_opencl_devices()[N]; anything else = the first device
 /// whose "platform: name" contains it (case-insensitive). Throws OpenClError when there is no
 /// OpenCL device or the kernels do not build on it (build_log() says why), UsageError when
-/// devices exist but none matches the selector. The backend is not thread-safe; create one
+/// devices exist but none matches the selector. Its calls throw OpenClError for a cloud whose
+/// buffers would not fit the device's memory (checked before any buffer is made) and for a
+/// device that runs out of memory all the same. The backend is not thread-safe; create one
 /// per thread (they share the built program).
 GT_API std::unique_ptr<FeatureBackend> make_opencl_backend(const std::string& selector = "");
 

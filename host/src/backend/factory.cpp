@@ -1,38 +1,63 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/features.hpp>
 #include <groovetrace/opencl.hpp>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace groovetrace {
 namespace {
 
-// The backend "auto" returns when OpenCL cannot run: the CPU reference, plus the reason.
-class FallbackBackend final : public FeatureBackend {
+// The backend "auto" returns: the OpenCL backend while it works, else the CPU reference and
+// the reason. A device error during a call (a cloud too large for the device's memory, a failed
+// allocation) reruns that call on the CPU, which returns it whole, and later calls stay there:
+// one run does not switch back and forth, and the backend named at its end is the one that
+// finished it.
+class AutoBackend final : public FeatureBackend {
  public:
-  FallbackBackend(std::unique_ptr<FeatureBackend> inner, std::string warning)
-      : inner_(std::move(inner)), warning_(std::move(warning)) {}
-  std::string name() const override { return inner_->name(); }
-  std::string device() const override { return inner_->device(); }
+  explicit AutoBackend(std::unique_ptr<FeatureBackend> opencl) : opencl_(std::move(opencl)) {}
+  explicit AutoBackend(const std::string& why)
+      : cpu_(make_cpu_backend()), warning_("OpenCL unavailable, using the cpu backend: " + why) {}
+
+  std::string name() const override { return active().name(); }
+  std::string device() const override { return active().device(); }
   std::string warning() const override { return warning_; }
   Cloud smooth(const Cloud& cloud, const SmoothParams& params) override {
-    return inner_->smooth(cloud, params);
+    return call([&](FeatureBackend& b) { return b.smooth(cloud, params); });
   }
   Normals normals(const Cloud& cloud, float radius, int min_neighbors) override {
-    return inner_->normals(cloud, radius, min_neighbors);
+    return call([&](FeatureBackend& b) { return b.normals(cloud, radius, min_neighbors); });
   }
   std::vector<float> descriptor(const Cloud& cloud, const Normals& normals, float radius,
                                 const Eigen::Vector3f& u_b) override {
-    return inner_->descriptor(cloud, normals, radius, u_b);
+    return call([&](FeatureBackend& b) { return b.descriptor(cloud, normals, radius, u_b); });
   }
   FeatureSet features(const Cloud& cloud, float radius, int min_neighbors) override {
-    return inner_->features(cloud, radius, min_neighbors);
+    return call([&](FeatureBackend& b) { return b.features(cloud, radius, min_neighbors); });
   }
   CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) override {
-    return inner_->crease(cloud, params);
+    return call([&](FeatureBackend& b) { return b.crease(cloud, params); });
   }
 
  private:
-  std::unique_ptr<FeatureBackend> inner_;
+  FeatureBackend& active() const { return opencl_ ? *opencl_ : *cpu_; }
+
+  template <typename Fn>
+  auto call(Fn&& fn) -> decltype(fn(std::declval<FeatureBackend&>())) {
+    if (opencl_) {
+      try {
+        return fn(*opencl_);
+      } catch (const OpenClError& e) {
+        warning_ = std::string("OpenCL failed, using the cpu backend: ") + e.what();
+        opencl_.reset();  // its buffers and queue go before the CPU's run
+        cpu_ = make_cpu_backend();
+      }
+    }
+    return fn(*cpu_);
+  }
+
+  std::unique_ptr<FeatureBackend> opencl_;  // null once the CPU has taken over
+  std::unique_ptr<FeatureBackend> cpu_;
   std::string warning_;
 };
 
@@ -64,15 +89,13 @@ std::unique_ptr<FeatureBackend> make_backend(const std::string& name, const std:
   if (name == "cpu") return make_cpu_backend();
   if (name == "opencl") return make_opencl_backend(device);
   if (name == "auto") {
-    // A missing driver or a kernel that does not compile on this device is not fatal here;
-    // a selector that names no device is (UsageError passes through).
+    // No driver, no device, a kernel that does not compile on this device, or a device error
+    // in a call (AutoBackend) is not fatal here; a selector that names no device is
+    // (UsageError passes through).
     try {
-      return make_opencl_backend(device);
+      return std::make_unique<AutoBackend>(make_opencl_backend(device));
     } catch (const OpenClError& e) {
-      return std::make_unique<FallbackBackend>(make_cpu_backend(),
-                                               std::string("OpenCL unavailable, using the cpu "
-                                                           "backend: ") +
-                                                   e.what());
+      return std::make_unique<AutoBackend>(std::string(e.what()));
     }
   }
   throw UsageError("unknown backend '" + name + "' (expected auto, cpu or opencl)");

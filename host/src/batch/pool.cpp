@@ -15,6 +15,7 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/features.hpp>
 #include <memory>
+#include <string>
 
 #include "batch/scan_dir.hpp"
 
@@ -47,8 +48,10 @@ std::string host_name() {
   char line[64];
   while (in && std::fgets(line, sizeof line, in)) {
     const std::size_t index = std::strtoul(line, nullptr, 10);
+    std::string warned;
     try {
       if (!backend) backend = make_backend(params.backend, params.device);
+      warned = backend->warning();
       run_scan(jobs.at(index), params, *backend, out_dir);
     } catch (const std::exception& e) {
       // The backend or OUTDIR itself failed: the scan's row says so.
@@ -60,6 +63,9 @@ std::string host_name() {
         ::_exit(static_cast<int>(ExitCode::kInput));
       }
     }
+    // A backend that fell back during this scan (auto: a cloud too large for the device) is set
+    // up anew for the next one, which may fit; the kernels stay built.
+    if (backend && backend->warning() != warned) backend.reset();
     const std::string done = std::to_string(index) + "\n";
     if (::write(out_fd, done.data(), done.size()) < 0) ::_exit(1);
   }

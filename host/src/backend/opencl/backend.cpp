@@ -19,6 +19,7 @@
 #include "core/frame_intrinsics.hpp"
 #include "device_program.hpp"
 #include "host_blocks.hpp"
+#include "memory_need.hpp"
 
 namespace groovetrace::ocl {
 namespace {
@@ -98,6 +99,23 @@ void buffer_allocated(cl::Buffer& b, const Allocation& a) {
 
 std::size_t round_up(std::size_t v, std::size_t m) { return (v + m - 1) / m * m; }
 
+// "12.5 MiB", for one-line messages.
+std::string bytes_text(std::uint64_t bytes) {
+  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+  double v = static_cast<double>(bytes);
+  int u = 0;
+  while (v >= 1024 && u < 4) v /= 1024, ++u;
+  char text[32];
+  std::snprintf(text, sizeof text, u == 0 ? "%.0f %s" : "%.1f %s", v, units[u]);
+  return text;
+}
+
+// Statuses of a device (or its driver's host side) out of memory.
+bool out_of_memory(cl_int status) {
+  return status == CL_MEM_OBJECT_ALLOCATION_FAILURE || status == CL_OUT_OF_RESOURCES ||
+         status == CL_OUT_OF_HOST_MEMORY || status == CL_INVALID_BUFFER_SIZE;
+}
+
 std::uint32_t next_pow2(std::size_t v) {
   std::uint32_t p = 1;
   while (p < v) p <<= 1;
@@ -111,6 +129,7 @@ class OpenClBackend final : public FeatureBackend {
         profile_(std::getenv("GROOVETRACE_OPENCL_PROFILE") != nullptr),
         search_(std::getenv("GROOVETRACE_OPENCL_SEARCH") ? std::getenv("GROOVETRACE_OPENCL_SEARCH")
                                                          : ""),
+        memory_(device_memory(dp_->device)),
         queue_(dp_->context, dp_->device, profile_ ? CL_QUEUE_PROFILING_ENABLE : 0),
         host_blocks_((dp_->device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0) {}
 
@@ -118,7 +137,7 @@ class OpenClBackend final : public FeatureBackend {
   std::string device() const override { return dp_->description; }
 
   Cloud smooth(const Cloud& cloud, const SmoothParams& params) override {
-    return guarded([&] {
+    return guarded(cloud.size(), [&] {
       if (cloud.size() == 0) return cloud;
       const Frame f = upload(cloud, params.radius);
       const Vec3Buffers out = search_buffers(f);
@@ -137,7 +156,7 @@ class OpenClBackend final : public FeatureBackend {
   }
 
   Normals normals(const Cloud& cloud, float radius, int min_neighbors) override {
-    return guarded([&] {
+    return guarded(cloud.size(), [&] {
       Normals out;
       out.resize(cloud.size());
       if (cloud.size() == 0) return out;
@@ -150,7 +169,7 @@ class OpenClBackend final : public FeatureBackend {
 
   std::vector<float> descriptor(const Cloud& cloud, const Normals& normals, float radius,
                                 const Eigen::Vector3f& u_b) override {
-    return guarded([&] {
+    return guarded(cloud.size(), [&] {
       if (normals.size() != cloud.size()) {
         throw InternalError("descriptor: " + std::to_string(normals.size()) + " normals for " +
                             std::to_string(cloud.size()) + " points");
@@ -173,7 +192,7 @@ class OpenClBackend final : public FeatureBackend {
   }
 
   CreaseMeasure crease(const Cloud& cloud, const CreaseParams& params) override {
-    return guarded([&] {
+    return guarded(cloud.size(), [&] {
       CreaseMeasure out;
       out.normals.resize(cloud.size());
       out.concavity.assign(cloud.size(), NAN);
@@ -196,7 +215,7 @@ class OpenClBackend final : public FeatureBackend {
   }
 
   FeatureSet features(const Cloud& cloud, float radius, int min_neighbors) override {
-    return guarded([&] {
+    return guarded(cloud.size(), [&] {
       FeatureSet out;
       out.normals.resize(cloud.size());
       out.benchmark_normal = Eigen::Vector3f::Constant(NAN);
@@ -215,18 +234,53 @@ class OpenClBackend final : public FeatureBackend {
   }
 
  private:
-  // Runs fn, turning OpenCL failures into OpenClError (exit code 5).
+  // Runs fn on a cloud of `points` points once it fits the device, turning OpenCL failures
+  // into OpenClError (exit code 5; `auto` reruns the call on the CPU). A device out of memory
+  // all the same (other processes' buffers, a driver's own limit) says so in the same terms.
   template <typename Fn>
-  auto guarded(Fn&& fn) -> decltype(fn()) {
+  auto guarded(std::size_t points, Fn&& fn) -> decltype(fn()) {
+    require_fits(points);
     try {
       auto result = fn();
       if (profile_) print_profile();
       return result;
     } catch (const cl::Error& e) {
-      throw OpenClError(std::string("OpenCL error on ") + dp_->description + ": " + e.what() +
-                            " failed with " + status_name(e.err()),
-                        e.err());
+      const std::string failed = std::string(e.what()) + " failed with " + status_name(e.err());
+      if (out_of_memory(e.err())) {
+        throw OpenClError("OpenCL device " + dp_->description +
+                              " ran out of memory or resources on " + std::to_string(points) +
+                              " points (" + failed + "; " + memory_text(points) + ")",
+                          e.err());
+      }
+      throw OpenClError("OpenCL error on " + dp_->description + ": " + failed, e.err());
     }
+  }
+
+  // What a call on `points` points needs (memory_need.hpp) against what the device offers.
+  std::string memory_text(std::size_t points) const {
+    const MemoryNeed need = memory_need(points);
+    return "needs up to " + bytes_text(need.total) + ", " + bytes_text(need.largest) +
+           " in one buffer; the device offers " + bytes_text(memory_.global) + ", " +
+           bytes_text(memory_.max_alloc) + " in one buffer" +
+           (memory_.limited ? " (GROOVETRACE_OPENCL_MEMORY_LIMIT)" : "");
+  }
+
+  // A cloud too large for the device is refused before any buffer is made, rather than failing
+  // halfway or being cut into tiles: a depth camera's frame (1280x720: at most 60 MiB) fits any
+  // OpenCL device, and `auto` runs a larger cloud on the CPU.
+  void require_fits(std::size_t points) const {
+    // Kernels index with 32-bit ints, and the grid table holds 2 slots per point.
+    if (points >= (std::size_t{1} << 30)) {
+      throw OpenClError("the OpenCL backend takes fewer than 2^30 points per cloud, not " +
+                            std::to_string(points) + "; --backend cpu runs it",
+                        0);
+    }
+    const MemoryNeed need = memory_need(points);
+    if (need.total <= memory_.global && need.largest <= memory_.max_alloc) return;
+    throw OpenClError("OpenCL device " + dp_->description + " has too little memory for " +
+                          std::to_string(points) + " points: " + memory_text(points) +
+                          "; --backend cpu runs it",
+                      0);
   }
 
   static int as_int(std::size_t v) { return static_cast<int>(v); }
@@ -345,10 +399,6 @@ class OpenClBackend final : public FeatureBackend {
   // `grid`: the grid search even for a pinhole frame.
   Frame upload(const Cloud& cloud, float radius, bool grid = false) {
     require_in_range(cloud);  // the kernels' cell keys are 32-bit ints
-    // Kernels index with 32-bit ints, and the grid table holds 2 slots per point.
-    if (cloud.size() >= (std::size_t{1} << 30)) {
-      throw InternalError("the OpenCL backend takes at most 2^30 points per cloud");
-    }
     Frame f;
     f.n = cloud.size();
     f.x = padded(cloud.x);
@@ -561,6 +611,7 @@ class OpenClBackend final : public FeatureBackend {
   bool profile_;
   // "grid" (GROOVETRACE_OPENCL_SEARCH): organized frames too use the grid search, to compare.
   std::string search_;
+  DeviceMemory memory_;  // what the device offers, or GROOVETRACE_OPENCL_MEMORY_LIMIT
   cl::CommandQueue queue_;
   std::vector<std::pair<std::string, cl::Event>> profiled_;
   std::vector<std::pair<std::string, double>> host_profiled_;  // ms

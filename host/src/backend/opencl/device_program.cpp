@@ -55,6 +55,30 @@ std::string first_error_line(const std::string& log) {
   return first.empty() ? "(empty build log)" : first;
 }
 
+// Why no device was found, for the one line: no platform at all (no driver installed), or
+// platforms that list no device (a driver without its hardware, or devices hidden from this
+// process, e.g. by POCL_DEVICES).
+std::string no_device_message() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    platforms.clear();
+  }
+  if (platforms.empty()) return "no OpenCL platform found (is an OpenCL driver installed?)";
+  std::string names;
+  for (const auto& p : platforms) {
+    try {
+      names += (names.empty() ? "" : ", ") + p.getInfo<CL_PLATFORM_NAME>();
+    } catch (const cl::Error&) {
+      names += (names.empty() ? "" : ", ") + std::string("(unnamed)");
+    }
+  }
+  const bool one = platforms.size() == 1;
+  return std::string("no OpenCL device found: the platform") + (one ? " " : "s ") + names +
+         (one ? " lists" : " list") + " no device";
+}
+
 std::mutex g_mutex;
 // Keyed by device and build options: a changed GROOVETRACE_OPENCL_* setting builds anew.
 std::map<std::pair<cl_device_id, std::string>, std::shared_ptr<const DeviceProgram>> g_programs;
@@ -84,8 +108,7 @@ std::vector<cl::Device> all_devices() {
 
 cl::Device select_device(const std::string& selector) {
   const std::vector<cl::Device> devices = all_devices();
-  if (devices.empty())
-    throw OpenClError("no OpenCL device found (is an OpenCL driver installed?)", 0);
+  if (devices.empty()) throw OpenClError(no_device_message(), 0);
   if (selector.empty()) {
     for (const auto& d : devices) {
       if (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) return d;
@@ -110,10 +133,30 @@ cl::Device select_device(const std::string& selector) {
   throw UsageError("device: no OpenCL device matches '" + selector + "' (devices: " + list + ")");
 }
 
+DeviceMemory device_memory(const cl::Device& device) {
+  DeviceMemory m;
+  m.global = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+  m.max_alloc = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  if (const char* env = std::getenv("GROOVETRACE_OPENCL_MEMORY_LIMIT")) {
+    char* end = nullptr;
+    const unsigned long long limit = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && limit > 0 && std::isdigit(static_cast<unsigned char>(*env))) {
+      m.global = std::min<std::uint64_t>(m.global, limit);
+      m.max_alloc = std::min<std::uint64_t>(m.max_alloc, limit);
+      m.limited = true;
+    }
+  }
+  return m;
+}
+
 std::shared_ptr<const DeviceProgram> program_for(const cl::Device& device) {
   const int vector_width = vector_width_for(device);
-  std::string options =
-      "-cl-std=CL1.2 -DVW=" + std::to_string(vector_width) + " -DPAD=" + std::to_string(kPointPad);
+  // -w: a successful build prints nothing. PoCL's clang writes its count of warnings ("333
+  // warnings generated.") straight to the process's stderr, past -q; on a CPU without AVX-512
+  // every float16 argument draws -Wpsabi, harmless here as the kernels and PoCL's built-ins are
+  // compiled for one target. A failed build's errors stay in its log.
+  std::string options = "-cl-std=CL1.2 -w -DVW=" + std::to_string(vector_width) +
+                        " -DPAD=" + std::to_string(kPointPad);
   // Extra compiler options, for experiments (e.g. -cl-mad-enable) and for the build-failure test.
   if (const char* extra = std::getenv("GROOVETRACE_OPENCL_OPTIONS")) {
     options += std::string(" ") + extra;

@@ -2,6 +2,7 @@
 // Device discovery and the per-process cache of built programs: each device gets one context
 // and one program holding every kernel, built on first use and shared by all backends.
 
+#include <cstdint>
 #include <groovetrace/opencl.hpp>
 #include <memory>
 #include <string>
@@ -38,9 +39,22 @@ std::vector<cl::Device> all_devices();
 /// no device at all, UsageError when none matches.
 cl::Device select_device(const std::string& selector);
 
+/// What a device offers the backend (bytes).
+struct DeviceMemory {
+  std::uint64_t global = 0;     ///< CL_DEVICE_GLOBAL_MEM_SIZE
+  std::uint64_t max_alloc = 0;  ///< CL_DEVICE_MAX_MEM_ALLOC_SIZE
+  bool limited = false;         ///< lowered by GROOVETRACE_OPENCL_MEMORY_LIMIT
+};
+
+/// The device's memory limits, each lowered to GROOVETRACE_OPENCL_MEMORY_LIMIT (bytes, a
+/// positive integer; anything else is ignored) when that is set: the tests' way to make a
+/// cloud too large for a device whose memory is the host's (PoCL: gigabytes).
+DeviceMemory device_memory(const cl::Device& device);
+
 /// The program for `device`, built on first use and kept for the life of the process.
 /// Throws OpenClError carrying the build log when the kernels do not compile. Build options
-/// are -DVW (see vector_width_for), -DPAD, and GROOVETRACE_OPENCL_OPTIONS when set.
+/// are -w (no warnings), -DVW (see vector_width_for), -DPAD, and GROOVETRACE_OPENCL_OPTIONS
+/// when set.
 std::shared_ptr<const DeviceProgram> program_for(const cl::Device& device);
 
 }  // namespace groovetrace::ocl
