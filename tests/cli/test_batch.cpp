@@ -159,8 +159,10 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
 
 TEST_F(CliBatch, HangingScanTimesOut) {
   write_scan(in_ / "line1" / "a.pcd", 1);
-  write_scan(in_ / "line1" / "hang.pcd", 2);  // waits forever: killed after 10 s
-  const auto r = test::run_cli(batch("--jobs 1 --scan-timeout 10 --progress none"), dir_,
+  // hang.pcd waits forever: killed after 30 s. The timeout leaves room for a.pcd, whose clock
+  // includes the worker's start: 10 s were too few in the sanitizer build on a loaded machine.
+  write_scan(in_ / "line1" / "hang.pcd", 2);
+  const auto r = test::run_cli(batch("--jobs 1 --scan-timeout 30 --progress none"), dir_,
                                "GROOVETRACE_TEST_HANG_SCAN=hang.pcd");
   EXPECT_EQ(r.exit_code, 6) << r.err;
   EXPECT_EQ(r.err, "");
