@@ -358,10 +358,12 @@ std::vector<std::string> apply_config_file(Params& params, const std::string& pa
     if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
     for (const auto& kv : root) {
       // A key or list element that is itself a list or map is no value (yaml-cpp's "bad
-      // conversion" was exit 5).
-      const bool scalars = std::all_of(kv.second.begin(), kv.second.end(),
-                                       [](const YAML::Node& e) { return e.IsScalar(); });
-      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || (kv.second.IsSequence() && scalars))) {
+      // conversion" was exit 5). Only a list is searched for them: a map's entries are no
+      // nodes, and asking one IsScalar() threw YAML::InvalidNode (exit 5 too).
+      const bool scalars =
+          kv.second.IsSequence() && std::all_of(kv.second.begin(), kv.second.end(),
+                                                [](const YAML::Node& e) { return e.IsScalar(); });
+      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || scalars)) {
         throw UsageError("config file " + path + ": " + shown_key(kv.first) +
                          " must be a value or a list of values");
       }
