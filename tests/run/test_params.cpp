@@ -112,5 +112,22 @@ TEST(ConfigFile, AMapAsAValueIsAUsageError) {
             std::string::npos);
 }
 
+TEST(ConfigFile, APathThatIsNotUtf8StillMakesJson) {
+  // fuzz_config_yaml: nlohmann's type_error on the invalid byte escaped validate (exit 5).
+  Params p;
+  apply_config_file(p, config_file("bytes.yaml", "hand_eye: he\xff.yaml\nflange_pose: fp.yaml\n"));
+  EXPECT_EQ(p.hand_eye_file, "he\xff.yaml");
+  EXPECT_NO_THROW(validate(p));
+  EXPECT_EQ(nlohmann::json::parse(params_json(p))["hand_eye"], "he\xef\xbf\xbd.yaml");
+}
+
+TEST(ConfigFile, ErrorsQuotingTheFileStayOneLine) {
+  // fuzz_config_yaml: a value or key with a line break in it broke the one-line message.
+  EXPECT_NE(config_error<UsageError>("nl.yaml", "radius: \"1\\n2\"\n").find("radius"),
+            std::string::npos);
+  EXPECT_NE(config_error<UsageError>("nl.json", "{\"a\\nb\": 1}").find("unknown parameter 'a?b'"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace groovetrace

@@ -75,7 +75,11 @@ std::string num(double v) {
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
-std::string quoted(const std::string& s) { return nlohmann::json(s).dump(); }
+// A path or device name need not be UTF-8 (Linux file names are bytes); report.json shows its
+// invalid bytes as U+FFFD rather than failing (nlohmann's type_error was exit 5).
+std::string quoted(const std::string& s) {
+  return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 // A field of one group of Params (the common ones are the group Params itself).
 template <class Group, class T>
@@ -305,19 +309,23 @@ const std::vector<ParamSpec>& param_specs() {
 void set_param(Params& params, const std::string& key, const std::string& value) {
   const std::string k = underscored(key);
   for (const auto& spec : param_specs()) {
-    if (spec.key == k) {
+    if (spec.key != k) continue;
+    try {
       spec.set(params, value);
-      return;
+    } catch (const UsageError& e) {
+      // The message quotes the value, which a config file may split over lines.
+      throw UsageError(io::shown(e.what()));
     }
+    return;
   }
-  throw UsageError("unknown parameter '" + key + "'");
+  throw UsageError("unknown parameter '" + io::shown(key, 100) + "'");
 }
 
 namespace {
 
 // A YAML key for a message: its text, or "a key" when it is no scalar.
 std::string shown_key(const YAML::Node& key) {
-  return key.IsScalar() ? key.as<std::string>() : std::string("a key");
+  return key.IsScalar() ? io::shown(key.Scalar(), 100) : std::string("a key");
 }
 
 }  // namespace
