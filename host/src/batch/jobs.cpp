@@ -35,8 +35,12 @@ bool is_synth_labels(const fs::path& p) {
   return fs::exists(p.parent_path() / (stem + ".truth.json"), ec);
 }
 
+// A scan's directory: its path without the extension. The stem of "..pcd" is ".", which named
+// OUTDIR itself; a file whose stem is "." or ".." keeps its extension.
 std::string without_extension(const fs::path& rel) {
-  return (rel.parent_path() / rel.stem()).generic_string();
+  const fs::path stem = rel.stem();
+  const bool dots = stem.empty() || stem == "." || stem == "..";
+  return (rel.parent_path() / (dots ? rel.filename() : stem)).generic_string();
 }
 
 std::vector<ScanJob> scans_in_directory(const fs::path& root) {
@@ -167,7 +171,7 @@ std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
     } else if (fs::is_regular_file(p, ec) && io::lower_extension(p.string()) == ".csv") {
       found = read_manifest(input);
     } else if (fs::exists(p, ec)) {
-      found.push_back({input, p.stem().string(), "", "", std::nullopt});
+      found.push_back({input, without_extension(p.filename()), "", "", std::nullopt});
     } else {
       throw InputError("input " + input + " does not exist");
     }
