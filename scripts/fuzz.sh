@@ -28,9 +28,15 @@ cmake --build "$B" --target fuzzers -j "${FUZZ_JOBS:-1}"
 
 rm -rf "$B/seeds" "$B/dicts"
 "$B/fuzz/fuzz_seeds" "$B"
-# The harnesses write each input to a file in a directory of their own under here.
-export GT_FUZZ_TMPDIR="$PWD/$B/tmp"
-rm -rf "$GT_FUZZ_TMPDIR" && mkdir -p "$GT_FUZZ_TMPDIR" "$B/logs"
+# The harnesses write each input to a file in a directory of their own under here: in memory
+# (/dev/shm) where there is one, so that no input waits for a disk.
+mkdir -p "$B/logs"
+if GT_FUZZ_TMPDIR=$(mktemp -d /dev/shm/groovetrace-fuzz.XXXXXX 2>/dev/null); then :; else
+  GT_FUZZ_TMPDIR="$PWD/$B/tmp"
+  rm -rf "$GT_FUZZ_TMPDIR" && mkdir -p "$GT_FUZZ_TMPDIR"
+fi
+export GT_FUZZ_TMPDIR
+trap 'rm -rf "$GT_FUZZ_TMPDIR"' EXIT
 
 seeds_of() {  # harness name -> its seed folder and dictionary
   local n=${1#fuzz_}
@@ -62,5 +68,4 @@ for h in "${harnesses[@]}"; do
   printf '%-22s %12s %8s %8s %8s  %s\n' "$h" "${runs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" \
     "$result"
 done
-rm -rf "$GT_FUZZ_TMPDIR"
 exit "$found"
