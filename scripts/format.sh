@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null || { echo "format: clang-format is missing (scripts/setup.sh)" >&2; exit 1; }
-mapfile -t files < <(find host tests benches examples kernels -type f \
+mapfile -t files < <(find host tests benches examples kernels fuzz -type f \
   \( -name '*.cpp' -o -name '*.hpp' -o -name '*.cl' \) | sort)
 if [ "${1:-}" = --check ]; then
   bad=()

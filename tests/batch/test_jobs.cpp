@@ -74,6 +74,40 @@ TEST(BatchJobs, ManifestCarriesEachCapturesPose) {
   EXPECT_THROW(read_manifest((d / "bad_view.csv").string()), InputError);
 }
 
+// Found by fuzz_manifest (docs/fuzzing.md). A job's directory is replaced whole by the batch:
+// a row climbing out with ".." or naming an absolute path had one outside OUTDIR, and a counted
+// name could be another row's own (a, a, a_2: two jobs in a_2), and "..pcd" had the directory
+// "." (OUTDIR).
+TEST(BatchJobs, ManifestDirectoriesStayInsideOutdirAndApart) {
+  const fs::path d = test::fresh_dir("batch_jobs_manifest_dirs");
+  std::ofstream(d / "m.csv") << "scan\n../x.pcd\n/data/cell/y.pcd\nsub/../../z.ply\n.\n"
+                                "a.pcd\na.pcd\na_2.pcd\n..pcd\n";
+  const auto jobs = list_jobs({(d / "m.csv").string()});
+  EXPECT_EQ(rels(jobs), (std::vector<std::string>{"..pcd", "a", "a_2", "a_3", "data/cell/y", "scan",
+                                                  "x", "z"}));
+  EXPECT_EQ(jobs[4].path, "/data/cell/y.pcd");  // the file is still the row's
+  EXPECT_EQ(jobs[6].path, (d / "../x.pcd").string());
+  // The stem of "..pcd" is ".": OUTDIR itself, as a folder's file or one named alone too.
+  touch(d / "in" / "..pcd");
+  EXPECT_EQ(rels(list_jobs({(d / "in").string()})), std::vector<std::string>{"..pcd"});
+  EXPECT_EQ(rels(list_jobs({(d / "in" / "..pcd").string()})), std::vector<std::string>{"..pcd"});
+}
+
+// fuzz_manifest: the header of a CRLF file kept its "\r" in the message, two lines on a
+// terminal.
+TEST(BatchJobs, ManifestErrorsAreOneLine) {
+  const fs::path d = test::fresh_dir("batch_jobs_manifest_crlf");
+  std::ofstream(d / "m.csv", std::ios::binary) << "file\r\nx.pcd\r\n";
+  try {
+    read_manifest((d / "m.csv").string());
+    ADD_FAILURE() << "a manifest without a scan column was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find_first_of("\r\n"), std::string::npos) << what;
+    EXPECT_NE(what.find("got 'file?'"), std::string::npos) << what;
+  }
+}
+
 TEST(BatchJobs, ShardsSplitTheSortedList) {
   std::vector<ScanJob> jobs(7);
   for (int i = 0; i < 7; ++i) jobs[i].rel = std::to_string(i);

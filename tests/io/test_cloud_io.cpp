@@ -613,6 +613,53 @@ TEST_F(CloudIo, CraftedPlyHeadersAreRefused) {
   EXPECT_EQ(grid_ok.count_valid(), 120u);
 }
 
+// An ASCII PLY of 120 vertices: x y z, then the vertex `properties` (header lines) with
+// `values` on every vertex line; `more_header` follows the vertex element.
+std::string ply_with_properties(const std::string& properties, const std::string& values,
+                                const std::string& more_header = "") {
+  std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 120\nproperty float x\nproperty float y\n"
+      "property float z\n" +
+      properties + more_header + "end_header\n";
+  for (int i = 0; i < 120; ++i) text += std::to_string(i) + " 0 0.5 " + values + "\n";
+  return text;
+}
+
+// Found by fuzz_ply (docs/fuzzing.md): vertex layouts that made PCL's PLYReader write past its
+// data, an assertion in it (exit 134), are refused before it reads them. Colours without red
+// (its blue moves on by an rgb field only red adds), alpha alone, a property between the
+// colours, a vertex list property (sized by the first vertex's list), a second vertex element
+// (the cloud restarted, the first one's count kept), and a header line starting with a blank
+// (PCL splits an obj_info line itself: an empty first word). Colours in order still read.
+TEST_F(CloudIo, PlyLayoutsPclWritesPastAreRefused) {
+  expect_rejected(
+      file("gb.ply", ply_with_properties("property uchar green\nproperty uchar blue\n", "1 2")),
+      "vertex colours must be uchar red, green, blue");
+  expect_rejected(file("alpha.ply", ply_with_properties("property uchar alpha\n", "1")),
+                  "vertex colours");
+  expect_rejected(file("split.ply", ply_with_properties("property uchar red\nproperty float f\n"
+                                                        "property uchar green\nproperty uchar "
+                                                        "blue\n",
+                                                        "1 0.5 2 3")),
+                  "vertex colours");
+  expect_rejected(file("list.ply", ply_with_properties("property list uchar float f\n", "1 0.5")),
+                  "vertex list properties are not read");
+  expect_rejected(file("two.ply", ply_with_properties("", "",
+                                                      "element vertex 1\nproperty uchar "
+                                                      "q\n") +
+                                      "7\n"),
+                  "a second vertex element");
+  expect_rejected(
+      file("blank.ply", crafted_ply(120, " obj_info num_cols 120\nobj_info num_rows 1\n")),
+      "line 3 starts with a blank");
+  const std::string rgba =
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+      "property float intensity\n";
+  EXPECT_EQ(
+      read_cloud(file("rgba.ply", ply_with_properties(rgba, "1 2 3 4 0.5")).string()).count_valid(),
+      120u);
+}
+
 TEST_F(CloudIo, FailuresPrintNothing) {
   // PCL would print its own multi-line errors; the caller's one line must be all there is.
   const fs::path cut = dir_ / "cut.ply";

@@ -1,7 +1,9 @@
 // The parameter table: each key writes its own method's field, reports the other method's
-// keys, and round-trips through report.json's text.
+// keys, and round-trips through report.json's text; config files the fuzzer found mishandled.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
@@ -79,6 +81,52 @@ TEST(Params, ValidateRefusesWhatTheFlagsWould) {
   Params r;
   r.hand_eye_file = "hand_eye.yaml";  // without the flange pose
   EXPECT_THROW(validate(r), UsageError);
+}
+
+// A config file of this text in the test's temp dir; its path.
+std::string config_file(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::path(::testing::TempDir()) / ("groovetrace_cfg_" + name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+// The error apply_config_file throws for `text` in a file called `name`, checked to be of
+// type E and one line; "" if it throws nothing.
+template <class E>
+std::string config_error(const std::string& name, const std::string& text) {
+  Params p;
+  try {
+    apply_config_file(p, config_file(name, text));
+  } catch (const E& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find_first_of("\r\n"), std::string::npos) << what;
+    return what;
+  }
+  return "";
+}
+
+TEST(ConfigFile, AMapAsAValueIsAUsageError) {
+  // fuzz_config_yaml: yaml-cpp's InvalidNode escaped (exit 5) when a value was a map.
+  EXPECT_NE(config_error<UsageError>("map.yaml", "slices:\n  a: 1\n")
+                .find("slices must be a value or a list of values"),
+            std::string::npos);
+}
+
+TEST(ConfigFile, APathThatIsNotUtf8StillMakesJson) {
+  // fuzz_config_yaml: nlohmann's type_error on the invalid byte escaped validate (exit 5).
+  Params p;
+  apply_config_file(p, config_file("bytes.yaml", "hand_eye: he\xff.yaml\nflange_pose: fp.yaml\n"));
+  EXPECT_EQ(p.hand_eye_file, "he\xff.yaml");
+  EXPECT_NO_THROW(validate(p));
+  EXPECT_EQ(nlohmann::json::parse(params_json(p))["hand_eye"], "he\xef\xbf\xbd.yaml");
+}
+
+TEST(ConfigFile, ErrorsQuotingTheFileStayOneLine) {
+  // fuzz_config_yaml: a value or key with a line break in it broke the one-line message.
+  EXPECT_NE(config_error<UsageError>("nl.yaml", "radius: \"1\\n2\"\n").find("radius"),
+            std::string::npos);
+  EXPECT_NE(config_error<UsageError>("nl.json", "{\"a\\nb\": 1}").find("unknown parameter 'a?b'"),
+            std::string::npos);
 }
 
 }  // namespace

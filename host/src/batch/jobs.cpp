@@ -35,8 +35,12 @@ bool is_synth_labels(const fs::path& p) {
   return fs::exists(p.parent_path() / (stem + ".truth.json"), ec);
 }
 
+// A scan's directory: its path without the extension. The stem of "..pcd" is ".", which named
+// OUTDIR itself; a file whose stem is "." or ".." keeps its extension.
 std::string without_extension(const fs::path& rel) {
-  return (rel.parent_path() / rel.stem()).generic_string();
+  const fs::path stem = rel.stem();
+  const bool dots = stem.empty() || stem == "." || stem == "..";
+  return (rel.parent_path() / (dots ? rel.filename() : stem)).generic_string();
 }
 
 std::vector<ScanJob> scans_in_directory(const fs::path& root) {
@@ -82,6 +86,17 @@ Eigen::Vector3f parse_viewpoint(const std::string& text, const std::string& wher
   return v;
 }
 
+// A manifest row's directory under OUTDIR: its scan path without extension, without the parts
+// that would leave OUTDIR. The batch replaces a scan's directory whole (and removes the old
+// one): "../x.pcd" or "/data/x.pcd" named OUTDIR/../x or /data/x before.
+std::string rel_inside(const std::string& scan) {
+  fs::path rel;
+  for (const fs::path& part : fs::path(scan).lexically_normal().relative_path()) {
+    if (!part.empty() && part != "." && part != "..") rel /= part;
+  }
+  return rel.empty() ? std::string("scan") : without_extension(rel);
+}
+
 std::string extension_of(const ScanJob& job) {
   const std::string ext = io::lower_extension(job.path);
   return ext.empty() ? ext : ext.substr(1);
@@ -95,10 +110,15 @@ void make_unique(std::vector<ScanJob>& jobs) {
   for (ScanJob& j : jobs) {
     if (extensions[j.rel].size() > 1) j.rel += "_" + extension_of(j);
   }
+  // A counted name may be another scan's own (a, a and a_2): counting goes on past those.
+  std::set<std::string> taken;
+  for (const ScanJob& j : jobs) taken.insert(j.rel);
   std::map<std::string, int> seen;
   for (ScanJob& j : jobs) {
-    const int n = seen[j.rel]++;
-    if (n > 0) j.rel += "_" + std::to_string(n + 1);
+    if (seen[j.rel]++ == 0) continue;
+    int n = 2;
+    while (!taken.insert(j.rel + "_" + std::to_string(n)).second) ++n;
+    j.rel += "_" + std::to_string(n);
   }
 }
 
@@ -112,8 +132,9 @@ std::vector<ScanJob> read_manifest(const std::string& path) {
   std::map<std::string, std::size_t> column;
   for (std::size_t c = 0; c < header.size(); ++c) column[header[c]] = c;
   if (!column.count("scan")) {
-    throw InputError("manifest " + path + ": the header must name a 'scan' column, got '" + line +
-                     "'");
+    // shown(): the line may end in the "\r" of a CRLF file, which would split the message.
+    throw InputError("manifest " + path + ": the header must name a 'scan' column, got '" +
+                     io::shown(line, 200) + "'");
   }
   const fs::path base = fs::path(path).parent_path();
   auto file = [&](const std::vector<std::string>& row, const char* name) -> std::string {
@@ -128,7 +149,7 @@ std::vector<ScanJob> read_manifest(const std::string& path) {
     if (row.size() != header.size())
       throw InputError(where + ": " + std::to_string(row.size()) + " cells, the header has " +
                        std::to_string(header.size()));
-    ScanJob job{file(row, "scan"), without_extension(row[column["scan"]]), file(row, "flange_pose"),
+    ScanJob job{file(row, "scan"), rel_inside(row[column["scan"]]), file(row, "flange_pose"),
                 file(row, "hand_eye"), std::nullopt};
     if (job.path.empty()) throw InputError(where + ": no scan");
     if (column.count("viewpoint") && !row[column["viewpoint"]].empty()) {
@@ -150,7 +171,7 @@ std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
     } else if (fs::is_regular_file(p, ec) && io::lower_extension(p.string()) == ".csv") {
       found = read_manifest(input);
     } else if (fs::exists(p, ec)) {
-      found.push_back({input, p.stem().string(), "", "", std::nullopt});
+      found.push_back({input, without_extension(p.filename()), "", "", std::nullopt});
     } else {
       throw InputError("input " + input + " does not exist");
     }

@@ -23,15 +23,44 @@ std::uint64_t ply_type_size(std::string_view t) {
   return 0;
 }
 
+// PCL's PLY reader fills vertex colours by hand: a uchar red adds a 4-byte rgb field, blue
+// writes it and moves on by 4 bytes, alpha amends it. Any other arrangement moves it past the
+// point it fills (green and blue without red: an assertion in its reader, exit 134), so the
+// vertex element's uchar colour properties, in order, must be one of these.
+bool uchar_colour(std::string_view name) {
+  for (const char* c :
+       {"red", "green", "blue", "diffuse_red", "diffuse_green", "diffuse_blue", "alpha"}) {
+    if (name == c) return true;
+  }
+  return false;
+}
+
+void check_colours(std::string colours) {
+  // Properties after the colours do not matter; one between them does.
+  while (colours.size() >= 2 && colours.compare(colours.size() - 2, 2, "| ") == 0) {
+    colours.resize(colours.size() - 2);
+  }
+  for (const char* ok :
+       {"", "red green blue ", "red green blue alpha ", "diffuse_red diffuse_green diffuse_blue ",
+        "diffuse_red diffuse_green diffuse_blue alpha "}) {
+    if (colours == ok) return;
+  }
+  reject("PLY vertex colours must be uchar red, green, blue (and alpha), one after another");
+}
+
 // The least number of data bytes the header's elements take, summed as the header is read,
-// and what PCL would build an organized grid from.
+// what PCL would build an organized grid from, and the vertex element's layout.
 struct PlyBodySize {
   bool ascii = true;
   std::uint64_t min_body = 0, element_min = 0, element_count = 0;
   std::uint64_t file_size = 0, vertices = 0, cols = 0, rows = 0;
   bool has_cols = false, has_rows = false;
+  bool in_vertex = false, seen_vertex = false;
+  std::string colours;  // the vertex element's uchar colour properties, "|" for any other
 
   void close_element() {
+    if (in_vertex) check_colours(colours);
+    in_vertex = false;
     // An element with no properties takes no data bytes; its entries are still looped over
     // (2^64 - 1 of them kept PCL's reader busy for minutes).
     if (element_min == 0 && element_count > file_size) {
@@ -64,7 +93,25 @@ void check_element(std::string_view name, PlyBodySize& body) {
   if (name == "range_grid") {
     reject("PLY range_grid elements are not read (save organized scans as PCD)");
   }
-  if (name == "vertex") body.vertices = body.element_count;
+  if (name != "vertex") return;
+  // PCL starts the cloud again at each vertex element but keeps the first one's count: the
+  // second one's vertices were written past the data.
+  if (body.seen_vertex) reject("malformed PLY header: a second vertex element");
+  body.seen_vertex = body.in_vertex = true;
+  body.vertices = body.element_count;
+}
+
+// PCL sizes a vertex list property by the first vertex's list and writes the others' through
+// it (a longer one later: an assertion), so vertices are read without lists.
+void check_vertex_property(const std::vector<std::string_view>& tokens, bool list,
+                           PlyBodySize& body) {
+  if (list) reject("PLY vertex list properties are not read");
+  const std::string_view name = tokens[2];
+  if ((tokens[1] == "uchar" || tokens[1] == "uint8") && uchar_colour(name)) {
+    body.colours += std::string(name) + " ";
+  } else if (!body.colours.empty()) {
+    body.colours += "| ";
+  }
 }
 
 // One header line after the magic; returns true at end_header.
@@ -96,6 +143,7 @@ bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bo
     if (size == 0 || (list && ply_type_size(tokens[3]) == 0)) {
       reject("malformed PLY header: line " + std::to_string(line_no) + " is a bad property line");
     }
+    if (body.in_vertex) check_vertex_property(tokens, list, body);
     body.element_min += body.ascii ? 2 : size;
   } else if (key == "end_header") {
     body.close_element();
@@ -118,13 +166,19 @@ void check_ply_structure(const std::string& content) {
   PlyBodySize body;
   body.file_size = content.size();
   while (!seen_end && pos < content.size()) {
-    const auto tokens = split_ws(next_line(content, pos));
+    const std::string_view line = next_line(content, pos);
+    const auto tokens = split_ws(line);
     ++line_no;
     if (line_no == 1) {
       if (tokens.size() != 1 || tokens[0] != "ply") reject("malformed PLY header: no 'ply' magic");
       continue;
     }
     if (tokens.empty()) continue;
+    // PCL hands an obj_info line to its callback as written and splits it at blanks itself: a
+    // leading blank made its first word empty, an assertion in its reader (exit 134).
+    if (line.front() == ' ' || line.front() == '\t') {
+      reject("malformed PLY header: line " + std::to_string(line_no) + " starts with a blank");
+    }
     seen_end = parse_ply_line(tokens, line_no, seen_format, body);
   }
   if (!seen_end) reject("malformed PLY header: no end_header line");

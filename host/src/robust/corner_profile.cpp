@@ -163,9 +163,10 @@ int upper_plate_points(const std::vector<Eigen::Vector2d>& pts, const Corner& c,
   const auto [on, dir] = fit_line(off, scale);
   if (std::abs(dir.dot(lower.dir)) < std::cos(deg_to_rad(15))) return 0;
   const Eigen::Vector2d n(-dir.y(), dir.x());
-  return static_cast<int>(std::count_if(off.begin(), off.end(), [&](const Eigen::Vector2d& p) {
-    return std::abs((p - on).dot(n)) <= tol;
-  }));
+  // C++17 lets no lambda capture a structured binding (clang refuses it), so `on` is copied.
+  return static_cast<int>(std::count_if(
+      off.begin(), off.end(),
+      [&, on = on](const Eigen::Vector2d& p) { return std::abs((p - on).dot(n)) <= tol; }));
 }
 
 // Why the fitted corner is not a fillet or lap joint, or nullptr when it is: both faces

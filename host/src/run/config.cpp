@@ -75,7 +75,11 @@ std::string num(double v) {
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
-std::string quoted(const std::string& s) { return nlohmann::json(s).dump(); }
+// A path or device name need not be UTF-8 (Linux file names are bytes); report.json shows its
+// invalid bytes as U+FFFD rather than failing (nlohmann's type_error was exit 5).
+std::string quoted(const std::string& s) {
+  return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 // A field of one group of Params (the common ones are the group Params itself).
 template <class Group, class T>
@@ -305,19 +309,23 @@ const std::vector<ParamSpec>& param_specs() {
 void set_param(Params& params, const std::string& key, const std::string& value) {
   const std::string k = underscored(key);
   for (const auto& spec : param_specs()) {
-    if (spec.key == k) {
+    if (spec.key != k) continue;
+    try {
       spec.set(params, value);
-      return;
+    } catch (const UsageError& e) {
+      // The message quotes the value, which a config file may split over lines.
+      throw UsageError(io::shown(e.what()));
     }
+    return;
   }
-  throw UsageError("unknown parameter '" + key + "'");
+  throw UsageError("unknown parameter '" + io::shown(key, 100) + "'");
 }
 
 namespace {
 
 // A YAML key for a message: its text, or "a key" when it is no scalar.
 std::string shown_key(const YAML::Node& key) {
-  return key.IsScalar() ? key.as<std::string>() : std::string("a key");
+  return key.IsScalar() ? io::shown(key.Scalar(), 100) : std::string("a key");
 }
 
 }  // namespace
@@ -358,10 +366,12 @@ std::vector<std::string> apply_config_file(Params& params, const std::string& pa
     if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
     for (const auto& kv : root) {
       // A key or list element that is itself a list or map is no value (yaml-cpp's "bad
-      // conversion" was exit 5).
-      const bool scalars = std::all_of(kv.second.begin(), kv.second.end(),
-                                       [](const YAML::Node& e) { return e.IsScalar(); });
-      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || (kv.second.IsSequence() && scalars))) {
+      // conversion" was exit 5). Only a list is searched for them: a map's entries are no
+      // nodes, and asking one IsScalar() threw YAML::InvalidNode (exit 5 too).
+      const bool scalars =
+          kv.second.IsSequence() && std::all_of(kv.second.begin(), kv.second.end(),
+                                                [](const YAML::Node& e) { return e.IsScalar(); });
+      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || scalars)) {
         throw UsageError("config file " + path + ": " + shown_key(kv.first) +
                          " must be a value or a list of values");
       }
