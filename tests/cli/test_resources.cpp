@@ -86,15 +86,14 @@ TEST_F(Resources, HeadersClaimingHugeCloudsAreRefusedBeforeAllocating) {
                                    {"huge_ascii.ply", ply_ascii}}) {
     SCOPED_TRACE(name);
     const fs::path out = dir_ / ("out_" + name);
-    const auto r = test::run_cli("run " + write(name, text).string() + " --backend cpu -o " +
-                                     out.string(),
-                                 dir_);
+    const auto r = test::run_cli(
+        "run " + write(name, text).string() + " --backend cpu -o " + out.string(), dir_);
     EXPECT_EQ(r.exit_code, 3) << r.err;
     EXPECT_TRUE(r.err.find("too large") != std::string::npos ||
                 r.err.find("truncated") != std::string::npos)
         << r.err;
-    const Finished f = run_measured({"run", (dir_ / name).string(), "--backend", "cpu", "-o",
-                                     out.string()});
+    const Finished f =
+        run_measured({"run", (dir_ / name).string(), "--backend", "cpu", "-o", out.string()});
     EXPECT_EQ(f.exit_code, 3);
     EXPECT_LT(f.peak_bytes, documented_peak_bytes(0));
   }
@@ -113,9 +112,8 @@ TEST_F(Resources, PeakMemoryOfARunIsBoundedByItsPoints) {
       for (const char* backend : {"auto", "cpu"}) {
         if (w > 640 && std::string(backend) == "cpu") continue;  // 10-20 s, and no new memory
         SCOPED_TRACE(scan.filename().string() + " " + method + " " + backend);
-        const Finished f =
-            run_measured({"run", scan.string(), "-q", "--method", method, "--backend", backend,
-                          "-o", (dir_ / "out").string()});
+        const Finished f = run_measured({"run", scan.string(), "-q", "--method", method,
+                                         "--backend", backend, "-o", (dir_ / "out").string()});
         EXPECT_EQ(f.exit_code, 0);
         EXPECT_LT(f.peak_bytes, documented_peak_bytes(static_cast<std::uint64_t>(w) * h))
             << f.peak_bytes / (1 << 20) << " MiB";
