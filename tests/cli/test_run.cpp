@@ -113,6 +113,18 @@ TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   EXPECT_EQ(moves, poses.size() - 1);  // every waypoint after the first is a movep
 }
 
+// A file name is bytes, not necessarily UTF-8: the run still succeeds, and its JSON files name
+// the scan with U+FFFD for the bytes that are not UTF-8 (nlohmann's dump threw: exit 5).
+TEST_F(CliRun, AScanPathThatIsNotUtf8StillRuns) {
+  const fs::path odd = dir_ / "scan\xff.pcd";
+  fs::copy_file(scan_, odd);
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli("run '" + odd.string() + "' -o " + out.string() + " -q", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  EXPECT_EQ(report["input"], (dir_ / "scan\xef\xbf\xbd.pcd").string());
+}
+
 // The same scan and parameters give byte-identical outputs whatever the thread count, for
 // both methods and on the default backend too; report.json differs only in its timings and
 // the device line (which names the thread count).

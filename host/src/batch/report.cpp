@@ -75,7 +75,7 @@ std::string summary_json(const std::vector<ScanRow>& rows, const RunStats& stats
       {"scans_run", stats.scans_run},
       {"frames_per_second", stats.seconds > 0 ? stats.scans_run / stats.seconds : 0.0},
       {"rows", scans}};
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 const char* kStyle =

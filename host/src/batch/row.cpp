@@ -44,7 +44,7 @@ std::string row_json(const ScanRow& r) {
                   {"total_ms", r.total_ms},
                   {"input_hash", r.input_hash},
                   {"params_hash", r.params_hash}};
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 ScanRow row_from_json(const std::string& text, const std::string& where) {

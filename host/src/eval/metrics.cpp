@@ -236,7 +236,7 @@ std::string metrics_json(const EvalMetrics& m, const std::string& truth,
        m.joint_found.empty() ? json(nullptr) : json(m.joint_found == m.joint_expected)},
       {"notes", m.notes},
   };
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string metrics_summary(const EvalMetrics& m) {

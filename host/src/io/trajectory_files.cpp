@@ -55,7 +55,7 @@ std::string trajectory_json(const Trajectory& trajectory, const Params& params) 
       {"length_m", trajectory.length},
       {"parameters", json::parse(params_json(params))},
       {"waypoints", waypoints}};
-  return doc.dump(2) + "\n";
+  return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace groovetrace

@@ -206,7 +206,7 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
   if (result.method == Method::robust) {
     report["robust"] = robust_report(result.robust, result.trajectories, params.robust.max_seams);
   }
-  return report.dump(2) + "\n";
+  return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace
