@@ -93,6 +93,18 @@ TEST(BatchJobs, ManifestDirectoriesStayInsideOutdirAndApart) {
   EXPECT_EQ(rels(list_jobs({(d / "in" / "..pcd").string()})), std::vector<std::string>{"..pcd"});
 }
 
+// A scan named after a file or folder the batch keeps in OUTDIR gets a counted name: its
+// directory would have stood where summary.csv goes (the batch then failed at its end), or
+// been the staging folder.
+TEST(BatchJobs, ScansNamedLikeTheBatchsOwnFilesAreCounted) {
+  const fs::path d = test::fresh_dir("batch_jobs_own_names");
+  for (const char* name : {"summary.csv.pcd", "summary.json.ply", "index.html.pcd", ".partial.pcd"})
+    touch(d / "in" / name);
+  EXPECT_EQ(
+      rels(list_jobs({(d / "in").string()})),
+      (std::vector<std::string>{".partial_2", "index.html_2", "summary.csv_2", "summary.json_2"}));
+}
+
 // fuzz_manifest: the header of a CRLF file kept its "\r" in the message, two lines on a
 // terminal.
 TEST(BatchJobs, ManifestErrorsAreOneLine) {

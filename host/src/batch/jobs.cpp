@@ -102,8 +102,13 @@ std::string extension_of(const ScanJob& job) {
   return ext.empty() ? ext : ext.substr(1);
 }
 
+// What the batch itself keeps in OUTDIR (batch/report.cpp's summaries and page, pool.cpp's
+// staging folder): a scan named summary.csv.pcd or .partial.pcd must not get one of these.
+const char* const kBatchOwn[] = {"summary.csv", "summary.json", "index.html", ".partial"};
+
 // Makes every job's directory unique: where scans of different types share one, each gets its
-// extension (x.pcd, x.ply: x_pcd, x_ply); scans that still share one are counted (s1, s1_2).
+// extension (x.pcd, x.ply: x_pcd, x_ply); scans that still share one, or that share the
+// batch's own names, are counted (s1, s1_2; summary.csv_2).
 void make_unique(std::vector<ScanJob>& jobs) {
   std::map<std::string, std::set<std::string>> extensions;
   for (const ScanJob& j : jobs) extensions[j.rel].insert(extension_of(j));
@@ -111,9 +116,10 @@ void make_unique(std::vector<ScanJob>& jobs) {
     if (extensions[j.rel].size() > 1) j.rel += "_" + extension_of(j);
   }
   // A counted name may be another scan's own (a, a and a_2): counting goes on past those.
-  std::set<std::string> taken;
+  std::set<std::string> taken(std::begin(kBatchOwn), std::end(kBatchOwn));
   for (const ScanJob& j : jobs) taken.insert(j.rel);
   std::map<std::string, int> seen;
+  for (const char* own : kBatchOwn) seen[own] = 1;
   for (ScanJob& j : jobs) {
     if (seen[j.rel]++ == 0) continue;
     int n = 2;
