@@ -12,7 +12,7 @@ namespace groovetrace::cli {
 namespace {
 
 // Exit code of a batch in which some scan was not ok (docs/batch.md, "Exit codes").
-constexpr int kSomeScansFailed = 6;
+constexpr int kSomeScansFailed = static_cast<int>(ExitCode::kNotAllOk);
 
 struct BatchCli {
   std::vector<std::string> inputs;

@@ -42,15 +42,18 @@ class CliBackend : public ::testing::Test {
     s.height = 240;
     scan_ = dir_ / "scan.pcd";
     write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));
+    // In the base frame (= the camera's): no camera-frame warning among the backend's lines.
+    calib_ = test::identity_calibration(dir_);
   }
   fs::path dir_, scan_;
+  std::string calib_;
 };
 
 TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend auto --method paper", dir_,
-      kNoOpenCl);
+  const auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() +
+                                   " --backend auto --method paper",
+                               dir_, kNoOpenCl);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
   const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
@@ -61,9 +64,9 @@ TEST_F(CliBackend, AutoFallsBackToCpuWithAWarning) {
 
 TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
-      kNoOpenCl);
+  const auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() +
+                                   " --backend opencl --method paper",
+                               dir_, kNoOpenCl);
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("groovetrace: error: ", 0), 0u) << r.err;
@@ -75,8 +78,9 @@ TEST_F(CliBackend, ExplicitOpenClWithoutPlatformFails) {
 TEST_F(CliBackend, PlatformWithoutDeviceFallsBackUnderAuto) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " -q", dir_,
-                               pocl_without_devices(dir_));
+  const auto r =
+      test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() + " -q", dir_,
+                    pocl_without_devices(dir_));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err,
             "groovetrace: warning: OpenCL unavailable, using the cpu backend: no OpenCL device "
@@ -90,9 +94,9 @@ TEST_F(CliBackend, PlatformWithoutDeviceFallsBackUnderAuto) {
 TEST_F(CliBackend, PlatformWithoutDeviceFailsExplicitOpenCl) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
-  const auto r =
-      test::run_cli("run " + scan_.string() + " -o " + out.string() + " --backend opencl", dir_,
-                    pocl_without_devices(dir_));
+  const auto r = test::run_cli(
+      "run " + scan_.string() + " " + calib_ + " -o " + out.string() + " --backend opencl", dir_,
+      pocl_without_devices(dir_));
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(r.err,
             "groovetrace: error: no OpenCL device found: the platform Portable Computing Language "
@@ -112,9 +116,9 @@ TEST_F(CliBackend, KernelBuildFailureNamesTheCompilerLog) {
   fs::create_symlink(victim, dir_ / "groovetrace-opencl-build.log");
   const std::string env =
       "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";  // common.cl refuses it
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
-      env);
+  const auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() +
+                                   " --backend opencl --method paper",
+                               dir_, env);
   EXPECT_EQ(r.exit_code, 5) << r.err;
   // One line of ours; PoCL's compiler prints its own count of errors to stderr as well.
   std::istringstream lines(r.err);
@@ -138,9 +142,9 @@ TEST_F(CliBackend, KernelBuildFailureUnderAutoFallsBackToCpu) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
   const std::string env = "TMPDIR=" + dir_.string() + " GROOVETRACE_OPENCL_OPTIONS=-DVW=3";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend auto --method paper -q", dir_,
-      env);
+  const auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() +
+                                   " --backend auto --method paper -q",
+                               dir_, env);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::istringstream lines(r.err);
   std::vector<std::string> ours;
@@ -169,7 +173,7 @@ TEST_F(CliBackend, ColdKernelCacheBuildPrintsNothingWithQuiet) {
   const fs::path cache = dir_ / "pocl-cache", out = dir_ / "out";
   fs::create_directories(cache);
   const auto r =
-      test::run_cli("run " + scan_.string() + " -o " + out.string() + " -q", dir_,
+      test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() + " -q", dir_,
                     "POCL_CACHE_DIR=" + cache.string() + " GROOVETRACE_OPENCL_OPTIONS=-DGT_CAT_");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
@@ -187,9 +191,9 @@ const char* kOneMiB = "GROOVETRACE_OPENCL_MEMORY_LIMIT=1048576";
 TEST_F(CliBackend, CloudTooLargeForTheDeviceFailsExplicitOpenCl) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --backend opencl --method paper", dir_,
-      kOneMiB);
+  const auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string() +
+                                   " --backend opencl --method paper",
+                               dir_, kOneMiB);
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("groovetrace: error: OpenCL device ", 0), 0u) << r.err;
@@ -206,7 +210,8 @@ TEST_F(CliBackend, CloudTooLargeForTheDeviceFallsBackUnderAuto) {
   for (const char* method : {"robust", "paper"}) {
     const fs::path out = dir_ / (std::string("out-") + method);
     const auto r = test::run_cli(
-        "run " + scan_.string() + " -o " + out.string() + " -q --method " + method, dir_, kOneMiB);
+        "run " + scan_.string() + " " + calib_ + " -o " + out.string() + " -q --method " + method,
+        dir_, kOneMiB);
     ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
     const std::string prefix = "groovetrace: warning: OpenCL failed, using the cpu backend: ";
     EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
@@ -230,9 +235,9 @@ TEST_F(CliBackend, BatchGoesBackToTheDeviceAfterACloudTooLarge) {
   test::VGrooveScene big;
   write_file_atomic((in / "a-big.pcd").string(), pcd_bytes(test::render_vgroove(big).cloud));
   fs::copy_file(scan_, in / "b-small.pcd");
-  const auto r = test::run_cli(
-      "batch " + in.string() + " -o " + out.string() + " --jobs 1 --method paper --backend auto",
-      dir_, "GROOVETRACE_OPENCL_MEMORY_LIMIT=16777216");
+  const auto r = test::run_cli("batch " + in.string() + " " + calib_ + " -o " + out.string() +
+                                   " --jobs 1 --method paper --backend auto",
+                               dir_, "GROOVETRACE_OPENCL_MEMORY_LIMIT=16777216");
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   const auto a = nlohmann::json::parse(test::read_text(out / "a-big" / "report.json"));
   EXPECT_EQ(a["backend"], "cpu");
@@ -246,9 +251,10 @@ TEST_F(CliBackend, BatchGoesBackToTheDeviceAfterACloudTooLarge) {
 }
 
 TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
-                                   " --method paper --backend opencl --device no-such-device-name",
-                               dir_);
+  const auto r =
+      test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + (dir_ / "out").string() +
+                        " --method paper --backend opencl --device no-such-device-name",
+                    dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("no-such-device-name"), std::string::npos) << r.err;
 }
@@ -256,9 +262,10 @@ TEST_F(CliBackend, UnknownDeviceIsAUsageError) {
 TEST_F(CliBackend, DeviceIndexPastAnyNumberIsAUsageError) {
   if (list_opencl_devices().empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   // Past unsigned long, std::stoul threw: exit 5, "internal: stoul".
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + (dir_ / "out").string() +
-                                   " --method paper --device 99999999999999999999",
-                               dir_);
+  const auto r =
+      test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + (dir_ / "out").string() +
+                        " --method paper --device 99999999999999999999",
+                    dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("no OpenCL device 99999999999999999999"), std::string::npos) << r.err;
 }
@@ -270,7 +277,7 @@ TEST_F(CliBackend, DefaultRunUsesOpenClAndNamesTheDevice) {
   const std::vector<OpenClDevice> devices = list_opencl_devices();
   if (devices.empty()) GTEST_SKIP() << "no OpenCL device on this machine";
   const fs::path out = dir_ / "out";
-  auto r = test::run_cli("run " + scan_.string() + " -o " + out.string(), dir_);
+  auto r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string(), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
@@ -279,7 +286,8 @@ TEST_F(CliBackend, DefaultRunUsesOpenClAndNamesTheDevice) {
   EXPECT_NE(report["device"].get<std::string>().find(devices[0].name), std::string::npos)
       << report["device"];
 
-  r = test::run_cli("run " + scan_.string() + " -o " + out.string(), dir_, kNoOpenCl);
+  r = test::run_cli("run " + scan_.string() + " " + calib_ + " -o " + out.string(), dir_,
+                    kNoOpenCl);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("groovetrace: warning: OpenCL unavailable"), std::string::npos) << r.err;
   report = nlohmann::json::parse(test::read_text(out / "report.json"));

@@ -119,7 +119,9 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   EXPECT_EQ(statuses(dir_ / "out" / "summary.csv"), expected);
   // One progress line per scan, and the scans after the crash still ran.
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 24) << r.err;
-  for (const char* f : {"trajectory.csv", "program.script", "report.json", "scan.json"}) {
+  // No calibration files: the trajectory is in camera coordinates, so no program (docs/robot.md).
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "line2" / "a" / "program.script"));
+  for (const char* f : {"trajectory.csv", "report.json", "scan.json"}) {
     EXPECT_TRUE(fs::exists(dir_ / "out" / "line2" / "a" / f)) << f;
   }
   EXPECT_FALSE(fs::exists(dir_ / "out" / "line2" / "crash" / "trajectory.csv"));

@@ -58,6 +58,7 @@ class OutputSet : public ::testing::Test {
     s.noise_sigma = 0.0002;
     scan_ = dir_ / "scan.pcd";
     write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));
+    test::identity_calibration(dir_);
   }
   // The flags of run A (robust), B (paper: every file differs from A's) and C (robust with
   // another waypoint step: the same time as A, so concurrent A and C write at once).
@@ -67,8 +68,19 @@ class OutputSet : public ::testing::Test {
     return {"--method", "robust", "--step", "0.003"};
   }
   std::vector<std::string> argv(char which) const {
-    std::vector<std::string> args = {"run", scan_.string(), "-o", out_.string(),
-                                     "-q",  "--backend",    "cpu"};
+    // Identity calibration files (written in SetUp): the set holds a program, and stderr only
+    // what the tests look for.
+    std::vector<std::string> args = {"run",
+                                     scan_.string(),
+                                     "-o",
+                                     out_.string(),
+                                     "-q",
+                                     "--backend",
+                                     "cpu",
+                                     "--hand-eye",
+                                     (dir_ / "hand_eye.yaml").string(),
+                                     "--flange-pose",
+                                     (dir_ / "flange.yaml").string()};
     for (const auto& f : flags(which)) args.push_back(f);
     return args;
   }

@@ -27,7 +27,9 @@ TEST(CliOverview, RunWritesOverviewPngInTheScansFrame) {
   write_file_atomic((dir / "fl.yaml").string(),
                     "translation: [0.412, -0.137, 0.305]\nrotation: [1.0, 0.0, 0.0, 0.0]\n");
   const std::string common = "run " + scan.string() + " --backend cpu -o ";
-  const auto camera = test::run_cli(common + (dir / "camera").string(), dir);
+  // Identity calibration: the same frame, but no camera-frame warning in the caption.
+  const auto camera = test::run_cli(
+      common + (dir / "camera").string() + " " + test::identity_calibration(dir), dir);
   ASSERT_EQ(camera.exit_code, 0) << camera.err;
   EXPECT_NE(camera.out.find("overview.png"), std::string::npos) << camera.out;
   const auto base =

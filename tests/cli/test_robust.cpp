@@ -55,7 +55,8 @@ TEST_F(CliRobust, GrooveOnABoxWithReportedCandidates) {
   const fs::path scan = write_scan(box.cloud, "box.pcd");
   const fs::path out = dir_ / "out";
   // robust is the default method.
-  const auto r = test::run_cli("run " + scan.string() + " -o " + out.string(), dir_);
+  const auto r = test::run_cli(
+      "run " + scan.string() + " -o " + out.string() + " --camera-frame-program=true", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   for (const char* f : {"annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
                         "program.script", "report.json"}) {
@@ -143,9 +144,11 @@ TEST_F(CliRobust, StepSlicesAndMaxSeams) {
           .cloud,
       "two.pcd");
   const auto r = test::run_cli("run " + scan.string() + " -o " + (dir_ / "a").string() +
-                                   " --method robust --max-seams 2 --step 0.004 -q",
+                                   " --method robust --max-seams 2 --step 0.004 -q "
+                                   "--camera-frame-program=true",
                                dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("seams found"), std::string::npos) << r.err;  // both exported
   ASSERT_TRUE(fs::is_regular_file(dir_ / "a" / "trajectory_1.csv"));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "a" / "program_1.script"));
   const auto first = csv_positions(dir_ / "a" / "trajectory.csv");
@@ -158,11 +161,22 @@ TEST_F(CliRobust, StepSlicesAndMaxSeams) {
   EXPECT_EQ(report["parameters"]["max_seams"], 2);
   EXPECT_EQ(report["robust"]["seams"][1]["file"], "trajectory_1.csv");
 
+  EXPECT_EQ(report["detection"]["seams_found"], 2);
+  EXPECT_EQ(report["detection"]["seams_exported"], 2);
+
+  // One seam exported of two: said on stderr and in report.json.
   const auto s = test::run_cli(
       "run " + scan.string() + " -o " + (dir_ / "b").string() + " --method robust --slices 25 -q",
       dir_);
   ASSERT_EQ(s.exit_code, 0) << s.err;
   EXPECT_EQ(csv_positions(dir_ / "b" / "trajectory.csv").size(), 25u);
+  EXPECT_NE(s.err.find("groovetrace: warning: 2 seams found, 1 exported; --max-seams 2 exports "
+                       "them all"),
+            std::string::npos)
+      << s.err;
+  const auto one = nlohmann::json::parse(test::read_text(dir_ / "b" / "report.json"));
+  EXPECT_EQ(one["detection"]["seams_found"], 2);
+  EXPECT_EQ(one["detection"]["seams_exported"], 1);
 }
 
 TEST_F(CliRobust, NoGrooveExitsWithFour) {

@@ -55,8 +55,9 @@ class CliRun : public ::testing::Test {
 
 TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   const fs::path out = dir_ / "out";
-  const auto r = test::run_cli(
-      "run " + scan_.string() + " -o " + out.string() + " --method paper --backend cpu", dir_);
+  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() +
+                                   " --method paper --backend cpu --camera-frame-program=true",
+                               dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("outputs in"), std::string::npos) << r.out;
   for (const char* f : {"annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
@@ -197,10 +198,11 @@ TEST_F(CliRun, FlagsOfTheOtherMethodAreWarnedAbout) {
   const fs::path out = dir_ / "out_other";
   const fs::path cfg = dir_ / "cfg.yaml";
   std::ofstream(cfg) << "radius: 0.004\n";
-  const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() + " --config " +
-                                   cfg.string() + " --radius 0.005 --step 0.003 --slices 20" +
-                                   " --method paper --backend cpu -q",
-                               dir_);
+  const auto r =
+      test::run_cli("run " + scan_.string() + " -o " + out.string() + " --config " + cfg.string() +
+                        " --radius 0.005 --step 0.003 --slices 20" +
+                        " --method paper --backend cpu -q " + test::identity_calibration(dir_),
+                    dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string step_warning = "step belongs to the robust method; the paper method ignores it";
   EXPECT_NE(r.err.find("warning: " + step_warning), std::string::npos) << r.err;
@@ -210,9 +212,10 @@ TEST_F(CliRun, FlagsOfTheOtherMethodAreWarnedAbout) {
   EXPECT_EQ(report["warnings"], nlohmann::json::array({step_warning}));
 
   const fs::path out2 = dir_ / "out_other_robust";
-  const auto r2 = test::run_cli("run " + scan_.string() + " -o " + out2.string() + " --config " +
-                                    cfg.string() + " --radius 0.005 --backend cpu -q",
-                                dir_);
+  const auto r2 =
+      test::run_cli("run " + scan_.string() + " -o " + out2.string() + " --config " + cfg.string() +
+                        " --radius 0.005 --backend cpu -q " + test::identity_calibration(dir_),
+                    dir_);
   ASSERT_EQ(r2.exit_code, 0) << r2.err;
   const std::string radius_warning =
       "radius belongs to the paper method; the robust method ignores it";

@@ -113,6 +113,36 @@ TEST(Eval, LateralOffsetIsLateralError) {
   EXPECT_EQ(m.waypoints, 37u);
 }
 
+// Two true seams 40 mm apart and two exported paths, one 1 mm beside each: every path is
+// scored against every seam on its own, so the pairs that match show it and the others do not.
+TEST(Eval, EveryExportedSeamAgainstEveryTrueOne) {
+  gt::SynthTruth t = hand_truth();
+  gt::Seam second = t.seams[0];
+  for (auto& p : second.root) p.y() = 0.04;
+  t.seams.push_back(second);
+  const auto scores =
+      gt::score_seams(t, {{"trajectory.csv", line_poses(-0.1, 0.1, 41, {0, 0.041, 0})},
+                          {"trajectory_1.csv", line_poses(-0.1, 0.1, 41, {0, 0.001, 0})}});
+  ASSERT_EQ(scores.size(), 4u);
+  const double lateral[2][2] = {{0.041, 0.001}, {0.001, 0.039}};  // [file][truth seam]
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto& s = scores[k];
+    EXPECT_EQ(s.file, k < 2 ? "trajectory.csv" : "trajectory_1.csv");
+    EXPECT_EQ(s.truth_seam, k % 2);
+    EXPECT_EQ(s.waypoints, 41u);
+    EXPECT_NEAR(s.lateral_mean, lateral[k / 2][k % 2], 1e-6) << k;
+    // Within the 6 mm coverage radius only where the path runs 1 mm beside the seam.
+    EXPECT_NEAR(s.coverage_percent, lateral[k / 2][k % 2] < 0.002 ? 100.0 : 0.0, 1e-9) << k;
+  }
+  const std::string text = gt::metrics_summary([&] {
+    gt::EvalMetrics m = gt::evaluate(t, t.label, {});
+    m.seam_scores = scores;
+    return m;
+  }());
+  EXPECT_NE(text.find("trajectory_1.csv against true seam 0: lateral 1.00 mm"), std::string::npos)
+      << text;
+}
+
 TEST(Eval, DepthOffsetIsDepthError) {
   const gt::SynthTruth t = hand_truth();
   // 1 mm towards the camera (-z): above the root, positive along the outward normal.

@@ -54,6 +54,16 @@ inline CliResult run_cli(const std::string& args, const std::filesystem::path& s
   return run_cli_command(env + " " + std::string(GT_CLI_PATH) + " " + args, scratch);
 }
 
+/// Flags for identity calibration files written into `dir` (the base frame is the camera's):
+/// a run with them writes its robot program without the camera-frame warning.
+inline std::string identity_calibration(const std::filesystem::path& dir) {
+  for (const char* f : {"hand_eye.yaml", "flange.yaml"}) {
+    std::ofstream(dir / f) << "translation: [0, 0, 0]\nrotation: [0, 0, 0, 1]\n";
+  }
+  return "--hand-eye " + (dir / "hand_eye.yaml").string() + " --flange-pose " +
+         (dir / "flange.yaml").string();
+}
+
 /// The names in a directory, sorted; hidden ones too.
 inline std::vector<std::string> entries(const std::filesystem::path& dir) {
   std::vector<std::string> names;
@@ -72,7 +82,10 @@ inline void expect_failure_report(const std::filesystem::path& out, int code,
   ASSERT_EQ(entries(out), std::vector<std::string>{"report.json"});
   const auto report = nlohmann::json::parse(read_text(out / "report.json"));
   EXPECT_EQ(report["exit_code"], code);
-  EXPECT_EQ(report["status"], code == 3 ? "invalid_input" : code == 4 ? "no_groove" : "error");
+  EXPECT_EQ(report["status"], code == 3   ? "invalid_input"
+                              : code == 4 ? "no_groove"
+                              : code == 7 ? "unsafe_program"
+                                          : "error");
   EXPECT_EQ(err.rfind("groovetrace: error: " + report["message"].get<std::string>(), 0), 0u) << err;
   for (const auto& name : entries(out.parent_path())) {
     EXPECT_EQ(name.find(".groovetrace-"), std::string::npos) << "left behind: " << name;

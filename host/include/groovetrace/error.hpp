@@ -8,11 +8,19 @@
 namespace groovetrace {
 
 /// Exit codes of the CLI (docs/design.md, "CLI contract"): 0 ok, 2 bad usage, 3 bad input, 4 no
-/// groove, 5 internal.
-enum class ExitCode : int { kOk = 0, kUsage = 2, kInput = 3, kNoGroove = 4, kInternal = 5 };
+/// groove, 5 internal, 6 (batch) a scan not ok, 7 a robot program failed its guards.
+enum class ExitCode : int {
+  kOk = 0,
+  kUsage = 2,
+  kInput = 3,
+  kNoGroove = 4,
+  kInternal = 5,
+  kNotAllOk = 6,
+  kUnsafe = 7
+};
 
 /// The status word of an exit code in report.json and batch summaries: ok, invalid_input,
-/// no_groove, or error (bad usage, internal).
+/// no_groove, unsafe_program, or error (bad usage, internal).
 inline const char* status_name(ExitCode code) {
   switch (code) {
     case ExitCode::kOk:
@@ -21,6 +29,8 @@ inline const char* status_name(ExitCode code) {
       return "invalid_input";
     case ExitCode::kNoGroove:
       return "no_groove";
+    case ExitCode::kUnsafe:
+      return "unsafe_program";
     default:
       return "error";
   }
@@ -47,6 +57,11 @@ struct GT_API InputError : Error {
 /// The scan was read but no groove was found in it (exit 4).
 struct GT_API NoGrooveError : Error {
   explicit NoGrooveError(const std::string& m) : Error(ExitCode::kNoGroove, m) {}
+};
+/// A robot program would break a guard (robot/guards.hpp): a pose not finite, a jump, a fast
+/// turn, the torch pointing out of the part, a pose outside the workspace (exit 7).
+struct GT_API UnsafeProgramError : Error {
+  explicit UnsafeProgramError(const std::string& m) : Error(ExitCode::kUnsafe, m) {}
 };
 /// A device or internal failure (exit 5).
 struct GT_API InternalError : Error {

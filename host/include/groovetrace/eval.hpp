@@ -75,6 +75,19 @@ struct EvalMetrics {
   std::string joint_expected;
   std::string joint_found;
 
+  /// Every exported trajectory (trajectory.csv, trajectory_1.csv, ...) against every true seam
+  /// on its own: the same waypoint and coverage metrics, but against that seam's root line
+  /// alone (evaluate_files; empty from evaluate).
+  struct SeamScore {
+    std::string file;            ///< the trajectory file
+    std::size_t truth_seam = 0;  ///< index into the truth's seams
+    std::size_t waypoints = 0;
+    double distance_mean = 0, lateral_mean = 0, depth_mean = 0;  ///< m
+    double tool_axis_mean_deg = 0;
+    double coverage_percent = 0;  ///< of that true seam's in-view root line
+  };
+  std::vector<SeamScore> seam_scores;
+
   std::vector<std::string> notes;  ///< caveats (frame, missing files)
 };
 
@@ -84,12 +97,22 @@ struct EvalMetrics {
 GT_API EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
                             const std::vector<ToolPose>& poses, const EvalOptions& options = {});
 
+/// Each trajectory in `trajectories` (file name, camera-frame poses) against each of the
+/// truth's seams alone (EvalMetrics::SeamScore), in that order.
+GT_API std::vector<EvalMetrics::SeamScore> score_seams(
+    const SynthTruth& truth,
+    const std::vector<std::pair<std::string, std::vector<ToolPose>>>& trajectories,
+    const EvalOptions& options = {});
+
 /// What evaluate_files reads from a `groovetrace run` output directory.
 struct RunOutput {
   std::uint32_t width = 0, height = 0;  ///< of annotated.pcd
   std::vector<std::uint8_t> groove;     ///< annotated.pcd field `groove`, per point
   std::vector<ToolPose> poses;          ///< trajectory.csv (empty if absent)
   bool has_trajectory = false;
+  /// trajectory.csv, trajectory_1.csv, ... (the next seams of `run --max-seams`): file name and
+  /// poses, until the first one missing.
+  std::vector<std::pair<std::string, std::vector<ToolPose>>> trajectories;
   std::string frame = "camera";  ///< trajectory.json "frame" when present
   double total_ms = 0;           ///< report.json end-to-end time; NaN if absent
   std::vector<std::pair<std::string, double>> stage_ms;  ///< report.json stage timings

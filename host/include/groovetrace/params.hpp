@@ -5,6 +5,7 @@
 // Units: lengths in metres, speeds in m/s, angles in degrees, times in seconds.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <groovetrace/export.hpp>
 #include <optional>
 #include <string>
@@ -81,6 +82,31 @@ struct ProgramParams {
   double arc_delay = 0.5;         ///< s to wait after arc on before moving
 };
 
+/// What a welder sets around the path (docs/robot.md): torch angles, weaving and passes. Angles
+/// are applied in the tool frame (z into the workpiece, x along travel, y = z x x).
+struct WeldParams {
+  double travel_angle = 0.0;     ///< deg, about tool y: + push (the torch leans forward), - drag
+  double work_angle = 0.0;       ///< deg, about tool x (the seam): + tilts the torch's z towards -y
+  std::string weave = "none";    ///< none, zigzag, sine or triangle
+  double weave_amplitude = 0.0;  ///< m, from the root line to either side (half the width)
+  double weave_wavelength = 0.004;  ///< m along the seam per period
+  bool multi_pass = false;  ///< plan root, fill and cap passes from the fitted V (robust only)
+  double bead_area = 0.0;   ///< m^2 of weld metal per pass; 0 = wire area * wire_feed / weld_speed
+  double wire_diameter = 0.0012;  ///< m
+  double wire_feed = 0.1;         ///< m/s (6 m/min)
+};
+
+/// Checks on every robot program before it is written (guards.hpp); a violation is exit 7.
+struct GuardParams {
+  double max_step = 0.02;           ///< largest distance between consecutive poses (m)
+  double max_step_rotation = 30.0;  ///< largest rotation between consecutive poses (deg)
+  /// Every pose, approach and retreat included, inside this box of the base frame (m); unset:
+  /// no box. Needs the calibration files.
+  std::optional<Eigen::AlignedBox3d> workspace;
+  /// Write the program even when its poses are in the camera frame (no calibration files).
+  bool camera_frame_program = false;
+};
+
 /// Parameters of a run: what both methods share, then each method's own (only the chosen
 /// method's are used; the CLI warns about flags of the other).
 struct Params {
@@ -93,6 +119,8 @@ struct Params {
   PaperParams paper;
   RobustParams robust;
   ProgramParams program;
+  WeldParams weld;
+  GuardParams guards;
 
   // Frames: robot base frame output when both are given (files, see docs/frames.md).
   std::string hand_eye_file;     ///< T_flange_camera

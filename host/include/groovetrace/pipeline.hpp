@@ -10,6 +10,7 @@
 #include <groovetrace/features.hpp>
 #include <groovetrace/paper.hpp>
 #include <groovetrace/params.hpp>
+#include <groovetrace/program.hpp>
 #include <groovetrace/robust.hpp>
 #include <groovetrace/trajectory.hpp>
 #include <groovetrace/version.hpp>
@@ -42,6 +43,15 @@ struct RunResult {
   /// trajectory_1.csv, ...); camera frame, or base frame when frames were given. Never empty
   /// after a successful run.
   std::vector<Trajectory> trajectories;
+  /// The passes of each exported seam's robot program, in `trajectories`' order and frame: the
+  /// path itself, or the planned multi-pass weld, woven and tilted as WeldParams say.
+  std::vector<std::vector<WeldPass>> passes;
+  /// The programs are written: the passes are in the base frame, or the camera-frame program
+  /// was asked for (GuardParams::camera_frame_program). Either way they passed the guards.
+  bool programs = false;
+  /// Seams found: the robust method's accepted seams (of which `trajectories` holds at most
+  /// max_seams), or 1 for the paper method.
+  std::size_t seams_found = 0;
   /// The transform the trajectories were moved by (p_base = T_base_camera * p_camera, the
   /// camera frame being the cloud's) when calibration files were given; unset when the
   /// trajectories stay in the cloud's frame.
@@ -57,8 +67,10 @@ struct RunResult {
 using StageCallback = std::function<void(const std::string& stage, double ms)>;
 
 /// Runs the method of `params` on `cloud` (metres): detection and trajectories, moved into the
-/// base frame when calibration files are given. Throws NoGrooveError when no groove is found,
-/// UsageError for bad parameters, InputError for unreadable calibration files.
+/// base frame when calibration files are given, and each one's weld passes, checked by the
+/// guards when a program is to be written. Throws NoGrooveError when no groove is found,
+/// UsageError for bad parameters, InputError for unreadable calibration files,
+/// UnsafeProgramError when a program would break a guard.
 GT_API RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureBackend& backend,
                               const StageCallback& on_stage = {});
 

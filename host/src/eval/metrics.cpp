@@ -191,6 +191,42 @@ EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& d
   return m;
 }
 
+std::vector<EvalMetrics::SeamScore> score_seams(
+    const SynthTruth& truth,
+    const std::vector<std::pair<std::string, std::vector<ToolPose>>>& trajectories,
+    const EvalOptions& options) {
+  std::vector<EvalMetrics::SeamScore> out;
+  for (const auto& [file, poses] : trajectories) {
+    for (std::size_t j = 0; j < truth.seams.size(); ++j) {
+      EvalMetrics one;
+      score_waypoints({truth.seams[j]}, poses, one);
+      score_coverage({truth.seams[j]}, poses, options, one);
+      out.push_back({file, j, one.waypoints, one.distance_mean, one.lateral_mean, one.depth_mean,
+                     one.tool_axis_mean_deg, one.coverage_percent});
+    }
+  }
+  return out;
+}
+
+namespace {
+
+nlohmann::json seam_scores_json(const std::vector<EvalMetrics::SeamScore>& scores) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& s : scores) {
+    out.push_back({{"file", s.file},
+                   {"truth_seam", s.truth_seam},
+                   {"waypoints", s.waypoints},
+                   {"distance_mean_m", s.distance_mean},
+                   {"lateral_mean_m", s.lateral_mean},
+                   {"depth_mean_m", s.depth_mean},
+                   {"tool_axis_mean_deg", s.tool_axis_mean_deg},
+                   {"coverage_percent", s.coverage_percent}});
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string metrics_json(const EvalMetrics& m, const std::string& truth,
                          const std::string& result) {
   using nlohmann::json;
@@ -234,6 +270,7 @@ std::string metrics_json(const EvalMetrics& m, const std::string& truth,
       {"joint_found", m.joint_found.empty() ? json(nullptr) : json(m.joint_found)},
       {"joint_match",
        m.joint_found.empty() ? json(nullptr) : json(m.joint_found == m.joint_expected)},
+      {"seams", seam_scores_json(m.seam_scores)},
       {"notes", m.notes},
   };
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
@@ -275,6 +312,14 @@ std::string metrics_summary(const EvalMetrics& m) {
   if (!m.joint_found.empty())
     s += "joint: expected " + m.joint_expected + ", found " + m.joint_found +
          (m.joint_found == m.joint_expected ? " (match)\n" : " (mismatch)\n");
+  for (const auto& seam : m.seam_scores) {
+    std::snprintf(buf, sizeof buf,
+                  "%s against true seam %zu: lateral %.2f mm, depth %.2f mm, tool axis %.2f "
+                  "deg, coverage %.1f %%\n",
+                  seam.file.c_str(), seam.truth_seam, seam.lateral_mean * 1e3,
+                  seam.depth_mean * 1e3, seam.tool_axis_mean_deg, seam.coverage_percent);
+    s += buf;
+  }
   for (const std::string& note : m.notes) s += "note: " + note + "\n";
   return s;
 }

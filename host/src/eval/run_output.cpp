@@ -153,6 +153,11 @@ RunOutput read_run_output(const std::string& result_dir) {
   if (read_file(dir + "trajectory.csv", bytes)) {
     out.poses = read_trajectory_csv(dir + "trajectory.csv");
     out.has_trajectory = true;
+    out.trajectories.emplace_back("trajectory.csv", out.poses);
+    for (int k = 1; read_file(dir + "trajectory_" + std::to_string(k) + ".csv", bytes); ++k) {
+      const std::string name = "trajectory_" + std::to_string(k) + ".csv";
+      out.trajectories.emplace_back(name, read_trajectory_csv(dir + name));
+    }
   }
   if (read_file(dir + "trajectory.json", bytes)) {
     const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
@@ -195,6 +200,7 @@ EvalMetrics evaluate_files(const std::string& scan_path, const std::string& resu
       std::isfinite(total) && total > 0.0 ? static_cast<double>(m.points) / (total * 1e-3) : kNaN;
   m.stage_ms = run.stage_ms;
   m.joint_found = run.joint;
+  m.seam_scores = score_seams(truth, run.trajectories, options);
   return m;
 }
 

@@ -102,6 +102,15 @@ Field<ProgramParams, T> program(T ProgramParams::*member) {
   return {&Params::program, member};
 }
 
+template <class T>
+Field<WeldParams, T> weld(T WeldParams::*member) {
+  return {&Params::weld, member};
+}
+template <class T>
+Field<GuardParams, T> guard(T GuardParams::*member) {
+  return {&Params::guards, member};
+}
+
 // A length parameter in metres with a plausible range, so that "--radius 3" (meant as mm)
 // is refused instead of running for an hour.
 template <class F>
@@ -125,6 +134,12 @@ ParamSpec integer(ParamScope scope, const std::string& key, const std::string& h
   return {key, help, scope,
           [=](Params& p, const std::string& t) { field.of(p) = int_in_range(key, t, lo, hi); },
           [=](const Params& p) { return std::to_string(field.of(p)); }};
+}
+template <class F>
+ParamSpec boolean(const std::string& key, const std::string& help, F field) {
+  return {key, help + ": true or false", ParamScope::common,
+          [=](Params& p, const std::string& t) { field.of(p) = parse_bool(key, t); },
+          [=](const Params& p) { return std::string(field.of(p) ? "true" : "false"); }};
 }
 ParamSpec choice(const std::string& key, const std::string& help, std::string Params::*field,
                  std::vector<std::string> allowed) {
@@ -270,6 +285,76 @@ void add_program_specs(std::vector<ParamSpec>& s) {
                    0.0, 60.0, "s"));
 }
 
+// The box as xmin,ymin,zmin,xmax,ymax,zmax (m, base frame); "null" or "" for none.
+std::optional<Eigen::AlignedBox3d> parse_workspace(const std::string& t) {
+  if (trim(t).empty() || trim(t) == "null") return std::nullopt;
+  std::stringstream ss(t);
+  std::string part;
+  std::vector<double> v;
+  while (std::getline(ss, part, ',')) v.push_back(parse_number("workspace", part));
+  if (v.size() != 6) {
+    throw UsageError("workspace: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (six numbers, m), got '" +
+                     t + "'");
+  }
+  const Eigen::Vector3d lo(v[0], v[1], v[2]), hi(v[3], v[4], v[5]);
+  if (!(lo.array() < hi.array()).all()) {
+    throw UsageError("workspace: each minimum must be below its maximum, got '" + t + "'");
+  }
+  return Eigen::AlignedBox3d(lo, hi);
+}
+
+std::string workspace_json(const Params& p) {
+  if (!p.guards.workspace) return "null";
+  const Eigen::Vector3d lo = p.guards.workspace->min(), hi = p.guards.workspace->max();
+  return "[" + num(lo.x()) + "," + num(lo.y()) + "," + num(lo.z()) + "," + num(hi.x()) + "," +
+         num(hi.y()) + "," + num(hi.z()) + "]";
+}
+
+// Torch angles, weaving and passes (docs/robot.md).
+void add_weld_specs(std::vector<ParamSpec>& s) {
+  constexpr auto kCommon = ParamScope::common;
+  s.push_back(real(kCommon, "travel_angle", "torch travel angle about tool y: + push, - drag",
+                   weld(&WeldParams::travel_angle), -60.0, 60.0, "deg"));
+  s.push_back(real(kCommon, "work_angle", "torch work angle about the seam (tool x)",
+                   weld(&WeldParams::work_angle), -60.0, 60.0, "deg"));
+  s.push_back({"weave", "weave pattern across the groove: none, zigzag, sine or triangle", kCommon,
+               [](Params& p, const std::string& t) {
+                 p.weld.weave = one_of("weave", t, {"none", "zigzag", "sine", "triangle"});
+               },
+               [](const Params& p) { return quoted(p.weld.weave); }});
+  s.push_back(length(kCommon, "weave_amplitude",
+                     "weave: from the root line to either side, at most half the fitted opening",
+                     weld(&WeldParams::weave_amplitude), 0.0, 0.05));
+  s.push_back(length(kCommon, "weave_wavelength", "weave: length of one period along the seam",
+                     weld(&WeldParams::weave_wavelength), 5e-4, 0.1));
+  s.push_back(boolean("multi_pass", "robust: root, fill and cap passes planned from the fitted V",
+                      weld(&WeldParams::multi_pass)));
+  s.push_back(real(kCommon, "bead_area", "weld metal per pass; 0 = wire area * feed / weld speed",
+                   weld(&WeldParams::bead_area), 0.0, 1e-3, "m^2"));
+  s.push_back(length(kCommon, "wire_diameter", "welding wire diameter",
+                     weld(&WeldParams::wire_diameter), 2e-4, 0.005));
+  s.push_back(real(kCommon, "wire_feed", "wire feed speed", weld(&WeldParams::wire_feed), 1e-3, 1.0,
+                   "m/s"));
+}
+
+// The checks every program passes before it is written (docs/robot.md, "Guards").
+void add_guard_specs(std::vector<ParamSpec>& s) {
+  constexpr auto kCommon = ParamScope::common;
+  s.push_back(length(kCommon, "max_step", "guard: largest step between consecutive poses",
+                     guard(&GuardParams::max_step), 1e-4, 1.0));
+  s.push_back(real(kCommon, "max_step_rotation", "guard: largest turn between consecutive poses",
+                   guard(&GuardParams::max_step_rotation), 0.1, 180.0, "deg"));
+  s.push_back({"workspace",
+               "guard: every pose inside XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX of the base frame (m); "
+               "needs --hand-eye and --flange-pose",
+               kCommon,
+               [](Params& p, const std::string& t) { p.guards.workspace = parse_workspace(t); },
+               workspace_json});
+  s.push_back(boolean("camera_frame_program",
+                      "write the robot program even when its poses are in the camera frame",
+                      guard(&GuardParams::camera_frame_program)));
+}
+
 std::vector<ParamSpec> build_specs() {
   std::vector<ParamSpec> s;
   add_common_specs(s);
@@ -283,6 +368,8 @@ std::vector<ParamSpec> build_specs() {
   add_detection_specs(s);
   add_waypoint_specs(s);
   add_program_specs(s);
+  add_weld_specs(s);
+  add_guard_specs(s);
   s.push_back(
       path("hand_eye", "T_flange_camera file (YAML/JSON, docs/frames.md)", &Params::hand_eye_file));
   s.push_back(path("flange_pose", "T_base_flange at capture (YAML/JSON, docs/frames.md)",

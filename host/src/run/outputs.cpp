@@ -1,6 +1,7 @@
 // The files of a run: annotated cloud, overview picture, trajectories, robot programs and
 // report.json, rendered as bytes first and then written as one set (io/output_dir.hpp).
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <groovetrace/cloud_io.hpp>
@@ -150,6 +151,8 @@ json detection_report(const RunResult& result, const Params& params) {
     d["components"] = sizes.size();
     d["component_sizes"] = sizes;
   }
+  d["seams_found"] = result.seams_found;
+  d["seams_exported"] = result.trajectories.size();
   d["benchmark_normal"] = {ub.x(), ub.y(), ub.z()};
   return d;
 }
@@ -169,6 +172,25 @@ json points_report(const Cloud& input, const RunResult& result) {
           {"with_normal", with_normal},
           {"above_threshold", above},
           {"groove", groove}};
+}
+
+// report.json "programs": per exported seam, its program file (null when none is written: the
+// poses are camera coordinates) and its passes in weld order.
+json programs_json(const RunResult& result,
+                   const std::vector<std::pair<std::string, std::string>>& files) {
+  json out = json::array();
+  for (std::size_t k = 0; k < result.passes.size(); ++k) {
+    const std::string name = k == 0 ? "program.script" : "program_" + std::to_string(k) + ".script";
+    const bool written =
+        std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.first == name; });
+    json passes = json::array();
+    for (const WeldPass& p : result.passes[k]) {
+      passes.push_back(
+          {{"name", p.name}, {"waypoints", p.path.waypoints.size()}, {"length_m", p.path.length}});
+    }
+    out.push_back({{"file", written ? json(name) : json(nullptr)}, {"passes", passes}});
+  }
+  return out;
 }
 
 // report.json "outputs": the other files of the set with their sizes, so a reader can tell
@@ -201,6 +223,7 @@ std::string report_json(const Cloud& input, const RunResult& result, const Param
                  {"points", points_report(input, result)},
                  {"detection", detection_report(result, params)},
                  {"trajectory", trajectory},
+                 {"programs", programs_json(result, files)},
                  {"timings_ms", timings},
                  {"warnings", result.warnings}};
   if (result.method == Method::robust) {
@@ -243,7 +266,10 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
     const Trajectory& t = result.trajectories[k];
     files.emplace_back("trajectory" + n + ".csv", trajectory_csv(t));
     files.emplace_back("trajectory" + n + ".json", trajectory_json(t, params));
-    files.emplace_back("program" + n + ".script", urscript_program(t, params.program));
+    if (result.programs) {
+      files.emplace_back("program" + n + ".script",
+                         urscript_program(result.passes[k].front().path, params.program));
+    }
   }
   files.emplace_back("report.json",
                      report_json(input, result, params, input_path, total_ms, files));

@@ -7,11 +7,15 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/frames.hpp>
+#include <groovetrace/guards.hpp>
 #include <groovetrace/pipeline.hpp>
+#include <groovetrace/weld.hpp>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <unordered_map>
+
+#include "run/plausibility.hpp"
 
 namespace groovetrace {
 namespace {
@@ -52,8 +56,12 @@ void run_robust(const Cloud& cloud, const Params& params, FeatureBackend& backen
   for (std::size_t i = 0; i < cloud.size(); ++i) r.score[i] = r.robust.concavity[i] * 1000.0f;
   r.score_unit = "mm";
   for (const SeamCandidate& s : r.robust.seams) {
-    if (!s.accepted || static_cast<int>(r.trajectories.size()) >= rp.max_seams) continue;
+    if (!s.accepted) continue;
+    ++r.seams_found;
+    if (static_cast<int>(r.trajectories.size()) >= rp.max_seams) continue;
     r.trajectories.push_back(seam_trajectory(s, rp));
+    r.passes.push_back(weld_passes(r.trajectories.back(), section_shapes(r.trajectories.back(), s),
+                                   params.weld, params.program, r.warnings));
   }
   if (r.trajectories.empty()) throw NoGrooveError(no_robust_groove(r.robust));
   timer.lap("trajectory");
@@ -106,8 +114,9 @@ Cloud paper_smoothed(const Cloud& cloud, const PaperParams& pp, FeatureBackend& 
 
 // --method paper, as published: MLS, normals, the descriptor D, threshold and components, and
 // the trajectory of slices through every point that passed.
-void run_paper(const Cloud& cloud, const PaperParams& pp, FeatureBackend& backend, RunResult& r,
+void run_paper(const Cloud& cloud, const Params& params, FeatureBackend& backend, RunResult& r,
                StageTimer& timer) {
+  const PaperParams& pp = params.paper;
   const float radius = static_cast<float>(pp.radius);
   require_in_range(cloud);
   require_affordable(cloud, std::max(pp.radius, pp.smooth ? pp.mls_radius : 0.0));
@@ -139,7 +148,34 @@ void run_paper(const Cloud& cloud, const PaperParams& pp, FeatureBackend& backen
   // root are separate creases, often separate parts, and their median lies between them.
   r.trajectories.push_back(paper_trajectory(smoothed, r.normals, d.groove, pp.slices,
                                             pp.median_max_iterations, pp.median_tolerance));
+  r.seams_found = 1;
+  r.passes.push_back(
+      weld_passes(r.trajectories.back(), {}, params.weld, params.program, r.warnings));
   timer.lap("trajectory");
+}
+
+// Without calibration files the poses are camera coordinates, which a robot would take for base
+// coordinates: no program unless asked for. Every program to be written passes the guards.
+void guard_programs(const Cloud& cloud, const Params& params, RunResult& r) {
+  if (r.seams_found > r.trajectories.size()) {
+    r.warnings.push_back(std::to_string(r.seams_found) + " seams found, " +
+                         std::to_string(r.trajectories.size()) + " exported; --max-seams " +
+                         std::to_string(r.seams_found) + " exports them all");
+  }
+  r.programs = r.T_base_camera.has_value() || params.guards.camera_frame_program;
+  if (!r.T_base_camera) {
+    r.warnings.push_back(
+        r.programs ? "the robot program is in camera coordinates (--camera-frame-program): "
+                     "no --hand-eye and --flange-pose were given"
+                   : "no robot program written: the trajectory is in camera coordinates "
+                     "(give --hand-eye and --flange-pose, or --camera-frame-program)");
+  }
+  if (!r.programs) return;
+  const Eigen::Vector3d viewpoint_camera = cloud.viewpoint.cast<double>();
+  const Eigen::Vector3d viewpoint =
+      r.T_base_camera ? Eigen::Vector3d(*r.T_base_camera * viewpoint_camera) : viewpoint_camera;
+  for (const auto& passes : r.passes)
+    check_program(passes, params.guards, params.program, viewpoint);
 }
 
 }  // namespace
@@ -163,6 +199,11 @@ void validate(const Params& params) {
   if (params.hand_eye_file.empty() != params.flange_pose_file.empty()) {
     throw UsageError("--hand-eye and --flange-pose must be given together");
   }
+  if (params.guards.workspace && params.hand_eye_file.empty()) {
+    throw UsageError(
+        "--workspace is a box of the robot's base frame: it needs --hand-eye and "
+        "--flange-pose");
+  }
 }
 
 RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend& backend,
@@ -185,12 +226,17 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
   if (params.method == Method::robust) {
     run_robust(cloud, params, backend, r, timer);
   } else {
-    run_paper(cloud, params.paper, backend, r, timer);
+    run_paper(cloud, params, backend, r, timer);
   }
+  for (const std::string& w : plausibility_warnings(cloud, r)) r.warnings.push_back(w);
   if (T_base_camera) {
     for (Trajectory& t : r.trajectories) transform_trajectory(t, *T_base_camera);
+    for (auto& passes : r.passes) {
+      for (WeldPass& p : passes) transform_trajectory(p.path, *T_base_camera);
+    }
     r.T_base_camera = T_base_camera;
   }
+  guard_programs(cloud, params, r);
   // Named once the stages are done: a backend still being set up (the CLI's) is waited for
   // only when a stage first needs it.
   r.backend = backend.name();
