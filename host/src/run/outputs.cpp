@@ -7,8 +7,8 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
+#include <groovetrace/program.hpp>
 #include <groovetrace/trajectory_io.hpp>
-#include <groovetrace/urscript.hpp>
 #include <groovetrace/version.hpp>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -243,7 +243,12 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
     const Trajectory& t = result.trajectories[k];
     files.emplace_back("trajectory" + n + ".csv", trajectory_csv(t));
     files.emplace_back("trajectory" + n + ".json", trajectory_json(t, params));
-    files.emplace_back("program" + n + ".script", urscript_program(t, params.program));
+    files.emplace_back("trajectory" + n + ".ros.yaml", trajectory_ros_yaml(t));
+    // One pass per seam for now; a multi-pass plan gives its passes here, in weld order.
+    const std::vector<WeldPass> passes = {WeldPass{"seam", t}};
+    for (auto& file : program_files(passes, params.program, "program" + n)) {
+      files.push_back(std::move(file));
+    }
   }
   files.emplace_back("report.json",
                      report_json(input, result, params, input_path, total_ms, files));
@@ -254,8 +259,9 @@ bool is_run_output(const std::string& name) {
   // The files render_outputs and write_failure_report make, eval's metrics.json (it scores
   // them), and the temporaries of an earlier version's per-file writes (.NAME.XXXXXXXX.tmp).
   static const std::regex kOutput(
-      R"(annotated\.pcd|overview\.png|report\.json|metrics\.json|trajectory(_[0-9]+)?\.(csv|json)|)"
-      R"(program(_[0-9]+)?\.script|\..+\.[A-Za-z0-9]{8}\.tmp)");
+      R"(annotated\.pcd|overview\.png|report\.json|metrics\.json|)"
+      R"(trajectory(_[0-9]+)?\.(csv|json|ros\.yaml)|program(_[0-9]+)?\.(script|mod|src|dat)|)"
+      R"(\..+\.[A-Za-z0-9]{8}\.tmp)");
   return std::regex_match(name, kOutput);
 }
 
