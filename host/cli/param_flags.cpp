@@ -4,6 +4,7 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
+#include <groovetrace/program.hpp>
 
 namespace groovetrace::cli {
 
@@ -18,6 +19,12 @@ void add_param_flags(CLI::App* sub, const std::shared_ptr<ParamFlags>& given) {
   sub->add_option("--config", given->config, "YAML or JSON file of parameters (flags win)");
   for (const auto& spec : param_specs()) {
     const std::string key = spec.key;
+    if (spec.flag) {  // a switch: given means on, and it takes no value
+      sub->add_flag_function(
+          "--" + dashed(key), [given, key](std::int64_t) { given->flags[key] = "true"; },
+          spec.help);
+      continue;
+    }
     sub->add_option_function<std::string>(
         "--" + dashed(key), [given, key](const std::string& v) { given->flags[key] = v; },
         spec.help);
@@ -37,6 +44,8 @@ Params parse_params(const ParamFlags& given, std::vector<std::string>& warnings)
     keys.push_back(key);
   }
   validate(params);
+  // Settings that depend on each other (the arc output of --robot) fail here, before the run.
+  check_program_params(params.program);
   for (const std::string& key : keys) {
     const std::string w = other_method_warning(params, key);
     if (!w.empty() && std::find(warnings.begin(), warnings.end(), w) == warnings.end()) {

@@ -21,6 +21,9 @@ struct GT_API ParamSpec {
   std::function<void(Params&, const std::string&)> set;
   /// The current value as a JSON literal (number, string, bool, array or null).
   std::function<std::string(const Params&)> json;
+  /// A switch that is off by default: on the command line a flag without a value
+  /// (`--dry-run` sets "true"); in a config file `key: true` or `key: false`.
+  bool flag = false;
 };
 
 /// Every parameter, in documentation order.

@@ -71,15 +71,29 @@ struct RobustParams {
   double fillet_leg = 0.007;
 };
 
-/// The robot program's motion and arc settings (URScript, urscript.hpp).
+/// The robot controller a program is written for (`--robot`, program.hpp).
+enum class Robot {
+  ur,    ///< Universal Robots URScript: program.script
+  abb,   ///< ABB RAPID module: program.mod
+  kuka,  ///< KUKA KRL: program.src and program.dat
+};
+
+/// "ur", "abb" or "kuka", as in `--robot` and report.json.
+GT_API const char* to_string(Robot robot);
+
+/// The robot program's controller, motion and arc settings (program.hpp).
 struct ProgramParams {
+  Robot robot = Robot::ur;        ///< the controller whose program is written
   double approach_offset = 0.05;  ///< approach/retreat distance along -tool z (m)
   double approach_speed = 0.1;    ///< m/s for approach and retreat moves
   double weld_speed = 0.008;      ///< m/s along the seam
   double acceleration = 0.5;      ///< m/s^2 for all moves
   double blend_radius = 0.002;    ///< requested movep blend radius (m), capped per segment
-  int arc_output = 0;             ///< standard digital output that switches the arc
-  double arc_delay = 0.5;         ///< s to wait after arc on before moving
+  /// The output that switches the arc: ur: standard digital output 0..7; kuka: $OUT[n],
+  /// 1..4096; abb: the signal doArcN.
+  int arc_output = 0;
+  double arc_delay = 0.5;  ///< s to wait after arc on before moving
+  bool dry_run = false;    ///< the same program with the arc never switched on
 };
 
 /// What a welder sets around the path (docs/robot.md): torch angles, weaving and passes. Angles

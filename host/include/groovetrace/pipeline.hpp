@@ -78,8 +78,9 @@ GT_API RunResult run_pipeline(const Cloud& cloud, const Params& params, FeatureB
 GT_API void validate(const Params& params);
 
 /// The output files of a run, as bytes, keyed by file name (annotated.pcd, overview.png,
-/// trajectory.csv, trajectory.json, program.script, report.json; with --max-seams N > 1 also
-/// trajectory_K.csv, trajectory_K.json and program_K.script for the K-th next seam).
+/// trajectory.csv, trajectory.json, trajectory.ros.yaml, the program of params.program.robot
+/// (program.script, program.mod, or program.src and program.dat), report.json; with
+/// --max-seams N > 1 also trajectory_K.* and program_K.* for the K-th next seam).
 GT_API std::vector<std::pair<std::string, std::string>> render_outputs(
     const Cloud& input, const RunResult& result, const Params& params,
     const std::string& input_path, double total_ms);

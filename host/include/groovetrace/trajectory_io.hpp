@@ -16,4 +16,11 @@ GT_API std::string trajectory_csv(const Trajectory& trajectory);
 /// per waypoint: position_m, quaternion_xyzw, rotation_vector_rad, euler_zyx_deg, support.
 GT_API std::string trajectory_json(const Trajectory& trajectory, const Params& params);
 
+/// ROS nav_msgs/Path as YAML, the way ROS 2 `ros2 topic echo --once` prints it (without its
+/// closing `---`, so the file is one YAML document): header (stamp 0, frame_id =
+/// trajectory.frame, "base" or "camera") and per waypoint a geometry_msgs/PoseStamped with
+/// the same header, position x, y, z (m) and orientation x, y, z, w (unit quaternion). Numbers
+/// are fixed-point with up to 9 decimals and always a decimal point (YAML floats).
+GT_API std::string trajectory_ros_yaml(const Trajectory& trajectory);
+
 }  // namespace groovetrace

@@ -127,7 +127,8 @@ std::string scan_row_html(const ScanRow& r, const std::string& out_dir) {
   const std::string d = href(r.dir);
   const bool has_picture = fs::exists(fs::path(out_dir) / r.dir / "thumbnail.png");
   std::string files;
-  for (const char* f : {"report.json", "trajectory.csv", "program.script", "annotated.pcd"}) {
+  for (const char* f : {"report.json", "trajectory.csv", "program.script", "program.mod",
+                        "program.src", "annotated.pcd"}) {
     if (fs::exists(fs::path(out_dir) / r.dir / f)) {
       files += "<a href=\"" + d + "/" + f + "\">" + f + "</a><br>";
     }

@@ -1,8 +1,10 @@
+#include <charconv>
 #include <cstdio>
 #include <groovetrace/config.hpp>
 #include <groovetrace/trajectory_io.hpp>
 #include <groovetrace/version.hpp>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 namespace groovetrace {
 
@@ -56,6 +58,57 @@ std::string trajectory_json(const Trajectory& trajectory, const Params& params) 
       {"parameters", json::parse(params_json(params))},
       {"waypoints", waypoints}};
   return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+namespace {
+
+// 0.4, -0.1, 1.0: up to 9 decimals, trailing zeros dropped but one kept; no sign on zero.
+std::string ros_float(double v) {
+  char buffer[512];  // any double: at most 309 digits before the point
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::fixed, 9);
+  if (end.ec != std::errc()) throw std::length_error("trajectory_ros_yaml: number too long");
+  std::string text(buffer, end.ptr);
+  if (text.find_first_not_of("-0.") == std::string::npos) return "0.0";
+  text.erase(text.find_last_not_of('0') + 1);
+  if (text.back() == '.') text += '0';
+  return text;
+}
+
+// A std_msgs/Header at `indent`: stamp zero (a path has no capture time here) and the frame.
+std::string ros_header(const std::string& indent, const std::string& frame) {
+  return indent + "header:\n" + indent + "  stamp:\n" + indent + "    sec: 0\n" + indent +
+         "    nanosec: 0\n" + indent + "  frame_id: " + frame + "\n";
+}
+
+}  // namespace
+
+std::string trajectory_ros_yaml(const Trajectory& trajectory) {
+  // "base" and "camera" are plain YAML scalars; any other name is quoted (a JSON string is a
+  // YAML double-quoted scalar).
+  const std::string& f = trajectory.frame;
+  const bool plain =
+      !f.empty() && f.find_first_not_of(
+                        "abcdefghijklmnopqrstuvwxyz"
+                        "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_/") == std::string::npos;
+  const std::string frame =
+      plain ? f : nlohmann::json(f).dump(-1, ' ', true, nlohmann::json::error_handler_t::replace);
+  std::string out = ros_header("", frame) + "poses:";
+  if (trajectory.waypoints.empty()) return out + " []\n";
+  out += "\n";
+  for (const Waypoint& w : trajectory.waypoints) {
+    const Eigen::Quaterniond q = w.orientation.normalized();
+    out += "- " + ros_header("  ", frame).substr(2);
+    out += "  pose:\n    position:\n";
+    out += "      x: " + ros_float(w.position.x()) + "\n";
+    out += "      y: " + ros_float(w.position.y()) + "\n";
+    out += "      z: " + ros_float(w.position.z()) + "\n";
+    out += "    orientation:\n";
+    out += "      x: " + ros_float(q.x()) + "\n";
+    out += "      y: " + ros_float(q.y()) + "\n";
+    out += "      z: " + ros_float(q.z()) + "\n";
+    out += "      w: " + ros_float(q.w()) + "\n";
+  }
+  return out;
 }
 
 }  // namespace groovetrace

@@ -265,9 +265,23 @@ void add_waypoint_specs(std::vector<ParamSpec>& s) {
                      paper(&PaperParams::median_tolerance), 1e-12, 1e-3));
 }
 
-// The robot program (URScript).
+Robot parse_robot(const std::string& text) {
+  const std::string t = one_of("robot", text, {"ur", "abb", "kuka"});
+  return t == "abb" ? Robot::abb : t == "kuka" ? Robot::kuka : Robot::ur;
+}
+
+// The robot program (program.hpp, docs/robot.md).
 void add_program_specs(std::vector<ParamSpec>& s) {
   constexpr auto kCommon = ParamScope::common;
+  s.push_back({"robot",
+               "robot program: ur (program.script), abb (program.mod) or kuka (program.src and "
+               "program.dat)",
+               kCommon, [](Params& p, const std::string& t) { p.program.robot = parse_robot(t); },
+               [](const Params& p) { return quoted(to_string(p.program.robot)); }});
+  s.push_back(
+      {"dry_run", "the same program with the arc never switched on", kCommon,
+       [](Params& p, const std::string& t) { p.program.dry_run = parse_bool("dry_run", t); },
+       [](const Params& p) { return std::string(p.program.dry_run ? "true" : "false"); }, true});
   s.push_back(length(kCommon, "approach_offset", "approach and retreat distance along -tool z",
                      program(&ProgramParams::approach_offset), 0.0, 1.0));
   s.push_back(real(kCommon, "approach_speed", "approach and retreat speed",
@@ -279,8 +293,10 @@ void add_program_specs(std::vector<ParamSpec>& s) {
   s.push_back(length(kCommon, "blend_radius",
                      "movep blend radius, capped at 0.4 of the shorter segment",
                      program(&ProgramParams::blend_radius), 0.0, 0.1));
-  s.push_back(integer(kCommon, "arc_output", "standard digital output that switches the arc",
-                      program(&ProgramParams::arc_output), 0, 7));
+  s.push_back(integer(kCommon, "arc_output",
+                      "output that switches the arc: ur standard digital output 0..7, kuka "
+                      "$OUT[1..4096], abb signal doArcN",
+                      program(&ProgramParams::arc_output), 0, 4096));
   s.push_back(real(kCommon, "arc_delay", "wait after arc on", program(&ProgramParams::arc_delay),
                    0.0, 60.0, "s"));
 }
@@ -387,6 +403,10 @@ std::string underscored(std::string key) {
 }  // namespace
 
 const char* to_string(Method method) { return method == Method::paper ? "paper" : "robust"; }
+
+const char* to_string(Robot robot) {
+  return robot == Robot::abb ? "abb" : robot == Robot::kuka ? "kuka" : "ur";
+}
 
 const std::vector<ParamSpec>& param_specs() {
   static const std::vector<ParamSpec> specs = build_specs();

@@ -8,8 +8,8 @@
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
+#include <groovetrace/program.hpp>
 #include <groovetrace/trajectory_io.hpp>
-#include <groovetrace/urscript.hpp>
 #include <groovetrace/version.hpp>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -180,15 +180,18 @@ json programs_json(const RunResult& result,
                    const std::vector<std::pair<std::string, std::string>>& files) {
   json out = json::array();
   for (std::size_t k = 0; k < result.passes.size(); ++k) {
-    const std::string name = k == 0 ? "program.script" : "program_" + std::to_string(k) + ".script";
-    const bool written =
-        std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.first == name; });
+    // The program's file for --robot (program.script, .mod, or .src beside its .dat).
+    const std::string stem = k == 0 ? "program." : "program_" + std::to_string(k) + ".";
+    const auto file = std::find_if(files.begin(), files.end(), [&](const auto& f) {
+      return f.first.rfind(stem, 0) == 0 && f.first.find(".dat") == std::string::npos;
+    });
     json passes = json::array();
     for (const WeldPass& p : result.passes[k]) {
       passes.push_back(
           {{"name", p.name}, {"waypoints", p.path.waypoints.size()}, {"length_m", p.path.length}});
     }
-    out.push_back({{"file", written ? json(name) : json(nullptr)}, {"passes", passes}});
+    out.push_back(
+        {{"file", file != files.end() ? json(file->first) : json(nullptr)}, {"passes", passes}});
   }
   return out;
 }
@@ -266,9 +269,11 @@ std::vector<std::pair<std::string, std::string>> render_outputs(const Cloud& inp
     const Trajectory& t = result.trajectories[k];
     files.emplace_back("trajectory" + n + ".csv", trajectory_csv(t));
     files.emplace_back("trajectory" + n + ".json", trajectory_json(t, params));
+    files.emplace_back("trajectory" + n + ".ros.yaml", trajectory_ros_yaml(t));
     if (result.programs) {
-      files.emplace_back("program" + n + ".script",
-                         urscript_program(result.passes[k].front().path, params.program));
+      for (auto& file : program_files(result.passes[k], params.program, "program" + n)) {
+        files.push_back(std::move(file));
+      }
     }
   }
   files.emplace_back("report.json",
@@ -280,8 +285,9 @@ bool is_run_output(const std::string& name) {
   // The files render_outputs and write_failure_report make, eval's metrics.json (it scores
   // them), and the temporaries of an earlier version's per-file writes (.NAME.XXXXXXXX.tmp).
   static const std::regex kOutput(
-      R"(annotated\.pcd|overview\.png|report\.json|metrics\.json|trajectory(_[0-9]+)?\.(csv|json)|)"
-      R"(program(_[0-9]+)?\.script|\..+\.[A-Za-z0-9]{8}\.tmp)");
+      R"(annotated\.pcd|overview\.png|report\.json|metrics\.json|)"
+      R"(trajectory(_[0-9]+)?\.(csv|json|ros\.yaml)|program(_[0-9]+)?\.(script|mod|src|dat)|)"
+      R"(\..+\.[A-Za-z0-9]{8}\.tmp)");
   return std::regex_match(name, kOutput);
 }
 
