@@ -300,6 +300,11 @@ TEST_F(FramesTest, BadMatricesAndUrPosesAreRefused) {
                "text after the UR pose");
   expect_error(write("word.txt", "p[0.1, 0.2, zero, 0, 0, 1]\n"), "must hold numbers");
   expect_error(write("inf.txt", "p[0.1, 0.2, inf, 0, 0, 1]\n"), "UR pose value 3 is not finite");
+  // Too large for a double: refused, not read as 0 (from_chars leaves it unset).
+  expect_error(write("over.txt", "1 0 0 1e999\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"),
+               "matrix value 4 is not finite");
+  expect_error(write("long.txt", "p[0, 0, 0, 1e308, 1e308, 1e308]\n"),
+               "the rotation vector's length is not finite");
   // A half turn and a rotation vector longer than pi are still the rotations they say.
   const Eigen::Isometry3d T =
       read_transform(write("ok.txt", "# flange\np [0.4, -0.1, 0.3, 0, 3.1415926535897931, 0]\n"));

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <optional>
 
 #include "io/text.hpp"
@@ -225,7 +226,7 @@ Eigen::MatrixXd cv_matrix(const Value& v, const std::string& key) {
     std::replace(text.begin(), text.end(), '\n', ' ');
     for (const auto word : io::split_ws(text)) {
       double d = 0;
-      if (!io::parse_number(word, d)) {
+      if (!parse_decimal(word, d)) {
         io::reject(key + ".data holds '" + io::shown(word, 40) + "', not a number");
       }
       values.push_back(d);
@@ -358,7 +359,7 @@ std::optional<std::vector<double>> numbers_only(const std::string& text) {
   std::vector<double> out;
   for (const auto word : io::split_ws(spaced)) {
     double d = 0;
-    if (!io::parse_number(word, d)) return std::nullopt;
+    if (!parse_decimal(word, d)) return std::nullopt;
     out.push_back(d);
   }
   if (out.empty()) return std::nullopt;
@@ -407,6 +408,9 @@ Calibration ur_pose(const std::string& body) {
   }
   require_finite(*v, "UR pose");
   const auto& p = *v;
+  if (!std::isfinite(Eigen::Vector3d(p[3], p[4], p[5]).norm())) {
+    io::reject("UR pose p[...]: the rotation vector's length is not finite");
+  }
   return make(rotation_vector_rotation(Eigen::Vector3d(p[3], p[4], p[5])),
               Eigen::Vector3d(p[0], p[1], p[2]), "ur_pose");
 }

@@ -4,7 +4,9 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "io/text.hpp"
@@ -16,6 +18,14 @@ std::string format_number(double v) {
   s.imbue(std::locale::classic());
   s << v;
   return s.str();
+}
+
+bool parse_decimal(std::string_view word, double& value) {
+  if (!word.empty() && word.front() == '+') word.remove_prefix(1);
+  const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+  if (end != word.data() + word.size() || word.empty()) return false;
+  if (ec == std::errc::result_out_of_range) value = std::numeric_limits<double>::quiet_NaN();
+  return ec == std::errc() || ec == std::errc::result_out_of_range;
 }
 
 double number(const Value& v, const std::string& where) {

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "robot/calibration_tree.hpp"
@@ -34,6 +35,10 @@ Eigen::Matrix3d matrix_rotation(const Eigen::Matrix3d& R, const std::string& whe
 Eigen::Isometry3d homogeneous(const Eigen::Matrix4d& M, const std::string& where);
 /// The rotation of a rotation vector (axis * angle, rad).
 Eigen::Matrix3d rotation_vector_rotation(const Eigen::Vector3d& r);
+
+/// A decimal number of a text layout (nan and inf included); one too large for a double reads
+/// as NaN, so that it is refused as not finite instead of read as 0.
+bool parse_decimal(std::string_view word, double& value);
 
 /// A number for a message, as few digits as show it.
 std::string format_number(double v);

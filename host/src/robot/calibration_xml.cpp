@@ -7,6 +7,7 @@
 
 #include "io/text.hpp"
 #include "robot/calibration_tree.hpp"
+#include "robot/calibration_values.hpp"
 
 namespace groovetrace::calib {
 namespace {
@@ -153,7 +154,7 @@ class XmlReader {
     const auto b = raw.find_first_not_of(" \t\r\n");
     v.text = b == std::string::npos ? "" : raw.substr(b, raw.find_last_not_of(" \t\r\n") - b + 1);
     double d = 0;
-    if (!v.text.empty() && io::parse_number(v.text, d)) v.number = d;
+    if (!v.text.empty() && parse_decimal(v.text, d)) v.number = d;
     return v;
   }
   Value container(const std::string& tag, const std::string& text,
