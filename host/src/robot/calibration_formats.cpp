@@ -207,21 +207,10 @@ bool is_cv_matrix(const Value& v) {
   return v.is_map() && v.find("rows") && v.find("cols") && v.find("data");
 }
 
-Eigen::MatrixXd cv_matrix(const Value& v, const std::string& key) {
-  const double rows = number(*v.find("rows"), key + ".rows");
-  const double cols = number(*v.find("cols"), key + ".cols");
-  if (rows != std::floor(rows) || cols != std::floor(cols) || rows < 1 || cols < 1 || rows > 4 ||
-      cols > 4) {
-    io::reject(key + " is " + format_number(rows) + "x" + format_number(cols) +
-               ", not a matrix of a transform");
-  }
-  const std::string dt = text_of(v.find("dt"));
-  if (v.find("dt") && dt != "d" && dt != "f") {
-    io::reject(key + ".dt is '" + io::shown(dt, 20) + "', expected d or f (numbers)");
-  }
-  const Value& data = *v.find("data");
+// A matrix's `data`: a list of numbers (YAML, JSON) or one text of them (XML).
+std::vector<double> cv_data(const Value& data, const std::string& key) {
   std::vector<double> values;
-  if (data.kind == Value::Kind::scalar && !data.number) {  // XML: the numbers as one text
+  if (data.kind == Value::Kind::scalar && !data.number) {
     std::string text = data.text;
     std::replace(text.begin(), text.end(), '\n', ' ');
     for (const auto word : io::split_ws(text)) {
@@ -238,6 +227,22 @@ Eigen::MatrixXd cv_matrix(const Value& v, const std::string& key) {
   } else if (data.number) {
     values.push_back(*data.number);
   }
+  return values;
+}
+
+Eigen::MatrixXd cv_matrix(const Value& v, const std::string& key) {
+  const double rows = number(*v.find("rows"), key + ".rows");
+  const double cols = number(*v.find("cols"), key + ".cols");
+  if (rows != std::floor(rows) || cols != std::floor(cols) || rows < 1 || cols < 1 || rows > 4 ||
+      cols > 4) {
+    io::reject(key + " is " + format_number(rows) + "x" + format_number(cols) +
+               ", not a matrix of a transform");
+  }
+  const std::string dt = text_of(v.find("dt"));
+  if (v.find("dt") && dt != "d" && dt != "f") {
+    io::reject(key + ".dt is '" + io::shown(dt, 20) + "', expected d or f (numbers)");
+  }
+  const std::vector<double> values = cv_data(*v.find("data"), key);
   const auto r = static_cast<int>(rows), c = static_cast<int>(cols);
   if (values.size() != static_cast<std::size_t>(r * c)) {
     io::reject(key + ".data has " + std::to_string(values.size()) + " values, expected " +
@@ -252,6 +257,15 @@ Eigen::MatrixXd cv_matrix(const Value& v, const std::string& key) {
   return M;
 }
 
+using Matrices = std::vector<std::pair<std::string, Eigen::MatrixXd>>;
+
+const Eigen::MatrixXd* lookup(const Matrices& found, const std::string& key) {
+  for (const auto& f : found) {
+    if (f.first == key) return &f.second;
+  }
+  return nullptr;
+}
+
 // The translation key that goes with rotation key `r`: R -> t, R_x -> t_x, rotation_x ->
 // translation_x (T for t too).
 std::vector<std::string> partner_keys(const std::string& r) {
@@ -261,48 +275,51 @@ std::vector<std::string> partner_keys(const std::string& r) {
   return {};
 }
 
-Calibration opencv(const Value& root, const std::string& format) {
-  std::vector<std::pair<std::string, Eigen::MatrixXd>> found;
-  for (const auto& [key, v] : root.entries) {
-    if (is_cv_matrix(v)) found.emplace_back(key, cv_matrix(v, key));
-  }
-  const auto lookup = [&](const std::string& key) -> const Eigen::MatrixXd* {
-    for (const auto& f : found) {
-      if (f.first == key) return &f.second;
-    }
-    return nullptr;
-  };
+// Every (3x3 rotation key, 3-vector translation key) pair by the names above.
+std::vector<std::pair<std::string, std::string>> rt_pairs(const Matrices& found) {
   std::vector<std::pair<std::string, std::string>> pairs;
   for (const auto& [key, M] : found) {
     for (const auto& tkey : partner_keys(key)) {
-      const Eigen::MatrixXd* t = lookup(tkey);
+      const Eigen::MatrixXd* t = lookup(found, tkey);
       if (t && M.rows() == 3 && M.cols() == 3 && t->size() == 3) pairs.emplace_back(key, tkey);
     }
   }
-  if (pairs.size() > 1) {
-    io::reject("holds more than one R/t pair (" + pairs[0].first + "/" + pairs[0].second + ", " +
-               pairs[1].first + "/" + pairs[1].second + "): keep only the one to use");
-  }
-  if (pairs.size() == 1) {
-    const Eigen::MatrixXd& t = *lookup(pairs[0].second);
-    return make(matrix_rotation(*lookup(pairs[0].first), pairs[0].first),
-                Eigen::Vector3d(t(0), t(1), t(2)), format);
-  }
-  std::vector<std::string> fours, names;
+  return pairs;
+}
+
+// Without an R/t pair: the one 4x4 matrix, else the refusal listing what the file holds.
+Eigen::Isometry3d single_homogeneous(const Matrices& found) {
+  std::vector<std::string> fours;
+  std::string list;
   for (const auto& [key, M] : found) {
-    names.push_back(key + " (" + std::to_string(M.rows()) + "x" + std::to_string(M.cols()) + ")");
+    list += (list.empty() ? "" : ", ") + io::shown(key, 40) + " (" + std::to_string(M.rows()) +
+            "x" + std::to_string(M.cols()) + ")";
     if (M.rows() == 4 && M.cols() == 4) fours.push_back(key);
   }
-  if (fours.size() == 1) {
-    const Eigen::Isometry3d T = homogeneous(*lookup(fours[0]), fours[0]);
-    return make(T.linear(), T.translation(), format);
-  }
-  std::string list;
-  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  if (fours.size() == 1) return homogeneous(*lookup(found, fours[0]), fours[0]);
   io::reject(
       "OpenCV storage holds no R/t pair (3x3 and 3x1 named R/t, R_<name>/t_<name> or "
       "rotation<name>/translation<name>) and not one 4x4 matrix; it holds: " +
       (list.empty() ? std::string("no matrix") : list));
+}
+
+Calibration opencv(const Value& root, const std::string& format) {
+  Matrices found;
+  for (const auto& [key, v] : root.entries) {
+    if (is_cv_matrix(v)) found.emplace_back(key, cv_matrix(v, io::shown(key, 40)));
+  }
+  const auto pairs = rt_pairs(found);
+  if (pairs.size() > 1) {
+    io::reject("holds more than one R/t pair (" + pairs[0].first + "/" + pairs[0].second + ", " +
+               pairs[1].first + "/" + pairs[1].second + "): keep only the one to use");
+  }
+  if (pairs.empty()) {
+    const Eigen::Isometry3d T = single_homogeneous(found);
+    return make(T.linear(), T.translation(), format);
+  }
+  const Eigen::MatrixXd& t = *lookup(found, pairs[0].second);
+  return make(matrix_rotation(*lookup(found, pairs[0].first), pairs[0].first),
+              Eigen::Vector3d(t(0), t(1), t(2)), format);
 }
 
 // ---- dispatch -------------------------------------------------------------------------------
