@@ -136,6 +136,39 @@ void calibration_seeds(const fs::path& yaml, const fs::path& json) {
   write(json / "hand_eye.json", R"({"translation": [0.05, -0.02, 0.1], "rotation": [0, 0, 0, 1]})");
   write(json / "flange_pose.json",
         R"({"rotation": [0.0, 0.7071068, 0.0, 0.7071068], "translation": [0.4, 0.1, 0.5]})");
+  // The other layouts (docs/frames.md), recognised by content whatever the harness names them.
+  write(yaml / "easy_handeye.yaml",
+        "parameters:\n  eye_on_hand: true\n  robot_effector_frame: tool0\n"
+        "  tracking_base_frame: cam\ntransformation:\n  qw: 1.0\n  qx: 0.0\n  qy: 0.0\n"
+        "  qz: 0.0\n  x: 0.05\n  y: -0.02\n  z: 0.1\n");
+  write(yaml / "easy_handeye2.calib",
+        "parameters:\n  calibration_type: eye_in_hand\n  robot_effector_frame: tool0\n"
+        "transform:\n  translation:\n    x: 0.05\n    y: -0.02\n    z: 0.1\n"
+        "  rotation:\n    x: 0.0\n    y: 0.0\n    z: 0.0\n    w: 1.0\n");
+  write(yaml / "ros_pose.yaml",
+        "pose:\n  position: {x: 0.4, y: 0.1, z: 0.5}\n"
+        "  orientation: {x: 0.0, y: 0.0, z: 0.0, w: 1.0}\n");
+  write(yaml / "opencv.yaml",
+        "%YAML:1.0\n---\nR_cam2gripper: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]\nt_cam2gripper: !!opencv-matrix\n"
+        "   rows: 3\n   cols: 1\n   dt: d\n   data: [ 5.e-02, -2.e-02, 1.e-01 ]\n");
+  write(yaml / "opencv.xml",
+        "<?xml version=\"1.0\"?>\n<opencv_storage>\n<R type_id=\"opencv-matrix\">\n"
+        "  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n  <data>\n"
+        "    1. 0. 0. 0. 1. 0. 0. 0. 1.</data></R>\n<t type_id=\"opencv-matrix\">\n"
+        "  <rows>3</rows>\n  <cols>1</cols>\n  <dt>d</dt>\n  <data>\n"
+        "    5.e-02 -2.e-02 1.e-01</data></t>\n<!-- Tsai -->\n</opencv_storage>\n");
+  write(yaml / "matrix.txt", "# rows\n0 -1 0 0.05\n1 0 0 -0.02\n0 0 1 0.1\n0 0 0 1\n");
+  write(yaml / "matrix.yaml",
+        "- [0, -1, 0, 0.05]\n- [1, 0, 0, -0.02]\n- [0, 0, 1, 0.1]\n"
+        "- [0, 0, 0, 1]\n");
+  write(yaml / "ur_pose.txt", "p[0.4, -0.1, 0.3, 0.0, 3.1415927, 0.0]\n");
+  write(json / "matrix.json", "[[0, -1, 0, 0.05], [1, 0, 0, -0.02], [0, 0, 1, 0.1], [0, 0, 0, 1]]");
+  write(json / "easy_handeye.json",
+        R"({"eye_on_hand": false, "transformation": {"x": 1, "y": 0, "z": 0.5, "qx": 0,)"
+        R"( "qy": 0, "qz": 0, "qw": 1}})");
+  write(json / "keyed.json", R"({"position": {"x": 0, "y": 0, "z": 0.1},)"
+                             R"( "quaternion_wxyz": [1, 0, 0, 0]})");
 }
 
 void manifest_seeds(const fs::path& dir) {
@@ -183,7 +216,44 @@ void dictionaries(const fs::path& dir) {
     keys.emplace_back(w);
   }
   dict("config.dict", keys);
-  dict("calibration.dict", {"translation", "rotation", "[", "]", "{", "}", ": ", "1e308"});
+  dict("calibration.dict", {"translation",
+                            "rotation",
+                            "[",
+                            "]",
+                            "{",
+                            "}",
+                            ": ",
+                            "1e308",
+                            "transformation",
+                            "transform",
+                            "parameters",
+                            "eye_on_hand",
+                            "calibration_type",
+                            "eye_in_hand",
+                            "qx",
+                            "qw",
+                            "position",
+                            "orientation",
+                            "quaternion",
+                            "_xyzw",
+                            "_wxyz",
+                            "pose",
+                            "p[",
+                            "%YAML:1.0\\x0a",
+                            "!!opencv-matrix",
+                            "rows",
+                            "cols",
+                            "dt",
+                            "data",
+                            "R_cam2gripper",
+                            "t_cam2gripper",
+                            "<opencv_storage>",
+                            "</opencv_storage>",
+                            "type_id=\\\"opencv-matrix\\\"",
+                            "<!--",
+                            "-->",
+                            "&amp;",
+                            "\\x0a"});
   dict("manifest.dict",
        {"scan", "flange_pose", "hand_eye", "viewpoint", ".pcd", ".ply", "..", "/", "\\\"", ","});
 }

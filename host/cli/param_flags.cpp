@@ -5,6 +5,7 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/pipeline.hpp>
 #include <groovetrace/program.hpp>
+#include <nlohmann/json.hpp>
 
 namespace groovetrace::cli {
 
@@ -15,19 +16,33 @@ std::string dashed(std::string key) {
   return key;
 }
 
+namespace {
+
+// " [default: 0.008]": a default Params' value as report.json shows it, strings bare; "none"
+// for a parameter not set by default.
+std::string default_note(const ParamSpec& spec) {
+  const auto j = nlohmann::json::parse(spec.json(Params()));
+  const std::string text = j.is_null() ? "" : j.is_string() ? j.get<std::string>() : j.dump();
+  return " [default: " + (text.empty() ? std::string("none") : text) + "]";
+}
+
+}  // namespace
+
 void add_param_flags(CLI::App* sub, const std::shared_ptr<ParamFlags>& given) {
-  sub->add_option("--config", given->config, "YAML or JSON file of parameters (flags win)");
+  sub->add_option("--config", given->config,
+                  "YAML or JSON file of parameters, or a report.json (flags win)");
   for (const auto& spec : param_specs()) {
     const std::string key = spec.key;
-    if (spec.flag) {  // a switch: given means on, and it takes no value
+    if (spec.flag) {  // a switch: given means on (--key=false: off), and it takes no value
       sub->add_flag_function(
-          "--" + dashed(key), [given, key](std::int64_t) { given->flags[key] = "true"; },
-          spec.help);
+          "--" + dashed(key),
+          [given, key](std::int64_t count) { given->flags[key] = count > 0 ? "true" : "false"; },
+          spec.help + default_note(spec));
       continue;
     }
     sub->add_option_function<std::string>(
         "--" + dashed(key), [given, key](const std::string& v) { given->flags[key] = v; },
-        spec.help);
+        spec.help + default_note(spec));
   }
 }
 

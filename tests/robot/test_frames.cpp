@@ -10,7 +10,10 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/frames.hpp>
 #include <groovetrace/rotation.hpp>
+#include <iterator>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -64,6 +67,10 @@ class FramesTest : public ::testing::Test {
     EXPECT_NE(message.find(fragment), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;  // one line for stderr
   }
+  static std::string test_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
   fs::path dir_;
 };
 
@@ -97,20 +104,231 @@ TEST_F(FramesTest, ReadsYamlAndJson) {
   EXPECT_LT((T.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
 }
 
+// The transform every file in tests/robot/data describes (make_golden.py wrote them with
+// numpy's Rodrigues formula, not with groovetrace): 0.7 rad about (1, -2, 2) / 3, then
+// (0.031, -0.012, 0.118) m.
+Eigen::Isometry3d golden_transform() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 2) / 3).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(0.031, -0.012, 0.118);
+  return T;
+}
+
+std::string golden(const std::string& name) {
+  return std::string(GT_SOURCE_DIR) + "/tests/robot/data/" + name;
+}
+
+TEST_F(FramesTest, EveryFormatReadsTheSameTransform) {
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"groovetrace.yaml", "groovetrace"},   {"groovetrace.json", "groovetrace"},
+      {"easy_handeye.yaml", "easy_handeye"}, {"easy_handeye2.calib", "easy_handeye2"},
+      {"opencv.yaml", "opencv_yaml"},        {"opencv.xml", "opencv_xml"},
+      {"matrix.txt", "matrix_text"},         {"matrix.json", "matrix_text"},
+      {"matrix.yaml", "matrix_list"},        {"ur_pose.txt", "ur_pose"},
+      {"ros_pose.yaml", "ros_pose"},         {"quaternion_wxyz.json", "groovetrace"}};
+  const Eigen::Isometry3d expected = golden_transform();
+  for (const auto& [name, format] : files) {
+    const groovetrace::Calibration c = groovetrace::read_calibration(golden(name));
+    EXPECT_EQ(c.format, format) << name;
+    EXPECT_LT((c.transform.matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-9) << name;
+    // Exactly rigid, whatever digits the file had.
+    EXPECT_LT(
+        (c.transform.linear() * c.transform.linear().transpose() - Eigen::Matrix3d::Identity())
+            .norm(),
+        1e-14)
+        << name;
+  }
+}
+
+TEST_F(FramesTest, TheContentDecidesNotTheExtension) {
+  // The same bytes under other names: an OpenCV YAML as .txt, a UR pose as .yaml, a JSON
+  // layout as .yml, a matrix without extension.
+  const Eigen::Isometry3d expected = golden_transform();
+  for (const auto& [from, to] :
+       std::vector<std::pair<std::string, std::string>>{{"opencv.yaml", "calib.txt"},
+                                                        {"ur_pose.txt", "pose.yaml"},
+                                                        {"groovetrace.json", "hand_eye.yml"},
+                                                        {"matrix.txt", "T_flange_camera"},
+                                                        {"opencv.xml", "result.yaml"}}) {
+    const std::string path = write(to, test_text(golden(from)));
+    EXPECT_LT((read_transform(path).matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-9)
+        << from << " as " << to;
+  }
+}
+
+TEST_F(FramesTest, HandEyeFilesSayTheirFrames) {
+  const groovetrace::Calibration ros1 = groovetrace::read_calibration(golden("easy_handeye.yaml"));
+  ASSERT_TRUE(ros1.eye_on_hand.has_value());
+  EXPECT_TRUE(*ros1.eye_on_hand);
+  EXPECT_EQ(ros1.parent_frame, "tool0");
+  EXPECT_EQ(ros1.child_frame, "camera_color_optical_frame");
+  const groovetrace::Calibration ros2 =
+      groovetrace::read_calibration(golden("easy_handeye2.calib"));
+  EXPECT_EQ(ros2.eye_on_hand, std::optional<bool>(true));
+  EXPECT_EQ(ros2.parent_frame, "tool0");
+  EXPECT_EQ(ros2.child_frame, "camera_link");
+  // Eye-on-base (older easy_handeye: the parameters at the top): T_base_camera.
+  const groovetrace::Calibration base = groovetrace::read_calibration(
+      write("eob.yaml",
+            "eye_on_hand: false\nrobot_base_frame: base_link\nrobot_effector_frame: tool0\n"
+            "tracking_base_frame: cam\ntransformation: {x: 1, y: 0, z: 0.5, qx: 0, qy: 0, qz: 0, "
+            "qw: 1}\n"));
+  EXPECT_EQ(base.eye_on_hand, std::optional<bool>(false));
+  EXPECT_EQ(base.parent_frame, "base_link");
+  EXPECT_LT((base.transform.translation() - Eigen::Vector3d(1, 0, 0.5)).norm(), 1e-15);
+}
+
+TEST_F(FramesTest, AQuaternionWithoutItsOrderIsRefused) {
+  // 0.1, 0.2, 0.3, 0.927 read as x, y, z, w or as w, x, y, z: two different rotations.
+  const std::string q = "[0.1, 0.2, 0.3, 0.9273618495495703]";
+  expect_error(write("q.yaml", "translation: [0, 0, 0]\nquaternion: " + q + "\n"),
+               "'quaternion' is a quaternion of 4 numbers that does not say its order");
+  expect_error(write("pose.yaml", "position: [0, 0, 0]\norientation: " + q + "\n"),
+               "name the fields (x, y, z, w) or the key (orientation_xyzw or orientation_wxyz)");
+  expect_error(write("tf.json", R"({"transform": {"translation": {"x": 0, "y": 0, "z": 0},)"
+                                R"( "rotation": )" +
+                                    q + "}}"),
+               "does not say its order");
+  // Named fields and an order in the key are read by them; so is groovetrace's own
+  // `rotation` list (x, y, z, w, documented), and 4 equal numbers (both readings agree).
+  const Eigen::Quaterniond xyzw(0.9273618495495703, 0.1, 0.2, 0.3);
+  const auto angle_to = [&](const std::string& path, const Eigen::Quaterniond& q) {
+    return Eigen::Quaterniond(read_transform(path).linear()).angularDistance(q);
+  };
+  EXPECT_LT(angle_to(write("named.yaml",
+                           "position: [0, 0, 0]\norientation: {w: 0.9273618495495703, "
+                           "x: 0.1, y: 0.2, z: 0.3}\n"),
+                     xyzw),
+            1e-12);
+  EXPECT_LT(angle_to(write("prefixed.yaml",
+                           "translation: [0, 0, 0]\nrotation: {qx: 0.1, qy: 0.2, "
+                           "qz: 0.3, qw: 0.9273618495495703}\n"),
+                     xyzw),
+            1e-12);
+  EXPECT_LT(
+      angle_to(write("keyed.yaml", "translation: [0, 0, 0]\nquaternion_xyzw: " + q + "\n"), xyzw),
+      1e-12);
+  EXPECT_LT(angle_to(write("own.yaml", "translation: [0, 0, 0]\nrotation: " + q + "\n"), xyzw),
+            1e-12);
+  EXPECT_LT(
+      angle_to(write("equal.yaml", "translation: [0, 0, 0]\nquaternion: [0.5, 0.5, 0.5, 0.5]\n"),
+               Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5)),
+      1e-12);
+  expect_error(write("half.yaml", "translation: [0, 0, 0]\nrotation: {x: 0, y: 0, z: 1}\n"),
+               "'rotation' has no 'w'");
+}
+
+TEST_F(FramesTest, BadHandEyeAndOpenCvFilesAreRefused) {
+  expect_error(write("eih.yaml", "transformation: {x: 0, y: 0, z: 0, qx: 0, qy: 0, qz: 0}\n"),
+               "'transformation' has no 'qw'");
+  expect_error(write("eih2.yaml",
+                     "eye_on_hand: maybe\ntransformation: {x: 0, y: 0, z: 0, qx: 0, "
+                     "qy: 0, qz: 0, qw: 1}\n"),
+               "eye_on_hand is 'maybe', expected true or false");
+  expect_error(write("eih3.calib",
+                     "parameters: {calibration_type: eye_on_table}\ntransform:\n"
+                     "  translation: {x: 0, y: 0, z: 0}\n"
+                     "  rotation: {x: 0, y: 0, z: 0, w: 1}\n"),
+               "calibration_type is 'eye_on_table'");
+  const std::string head = "%YAML:1.0\n---\n";
+  const auto mat = [](const std::string& name, int rows, int cols, const std::string& data) {
+    return name + ": !!opencv-matrix\n   rows: " + std::to_string(rows) +
+           "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ " + data + " ]\n";
+  };
+  const std::string t = mat("t", 3, 1, "0., 0., 0.1");
+  expect_error(write("skew.yaml", head + mat("R", 3, 3, "1., 0.1, 0., 0., 1., 0., 0., 0., 1.") + t),
+               "R is not a rotation: R^T R differs from the identity by 0.1");
+  expect_error(
+      write("mirror.yaml", head + mat("R", 3, 3, "1., 0., 0., 0., 1., 0., 0., 0., -1.") + t),
+      "R is a reflection");
+  expect_error(write("count.yaml", head + mat("R", 3, 3, "1., 0., 0., 0., 1., 0., 0., 0.") + t),
+               "R.data has 8 values, expected 9 (3x3)");
+  expect_error(write("alone.yaml", head + mat("R_cam2gripper", 3, 3, "1,0,0,0,1,0,0,0,1")),
+               "holds no R/t pair");
+  expect_error(write("pairs.yaml", head + mat("R", 3, 3, "1,0,0,0,1,0,0,0,1") + t +
+                                       mat("R_cam2base", 3, 3, "1,0,0,0,1,0,0,0,1") +
+                                       mat("t_cam2base", 3, 1, "0,0,0")),
+               "more than one R/t pair");
+  expect_error(write("nan.yaml", head + mat("R", 3, 3, "1,0,0,0,1,0,0,0,.nan") + t),
+               "R.data[8] is not finite");
+  const std::string xml_r =
+      "<R type_id=\"opencv-matrix\"><rows>3</rows><cols>3</cols><dt>d</dt>"
+      "<data>1 0 0 0 1 0 0 0 1</data></R>";
+  const std::string xml_t =
+      "<t type_id=\"opencv-matrix\"><rows>3</rows><cols>1</cols><dt>d</dt>"
+      "<data>0 0 0.1</data></t>";
+  EXPECT_LT(
+      (read_transform(write("ok.xml", "<opencv_storage>" + xml_r + xml_t + "</opencv_storage>"))
+           .translation() -
+       Eigen::Vector3d(0, 0, 0.1))
+          .norm(),
+      1e-15);
+  expect_error(write("open.xml", "<opencv_storage>" + xml_r + xml_t), "is not closed");
+  expect_error(write("root.xml", "<?xml version=\"1.0\"?>\n<storage>" + xml_r + "</storage>"),
+               "root element is 'storage', expected 'opencv_storage'");
+  expect_error(
+      write("mixed.xml", "<opencv_storage>" + xml_r + "words" + xml_t + "</opencv_storage>"),
+      "mixes text and elements");
+  expect_error(write("tag.xml", "<opencv_storage>" + xml_r + xml_t + "</opencv>"),
+               "closing tag does not match 'opencv_storage'");
+  expect_error(write("dtd.xml", "<!DOCTYPE x [ <!ENTITY a \"b\"> ]><opencv_storage/>"),
+               "DTD or CDATA is not supported");
+  expect_error(write("word.xml",
+                     "<opencv_storage><R type_id=\"opencv-matrix\"><rows>3</rows>"
+                     "<cols>3</cols><dt>d</dt><data>1 0 0 0 one 0 0 0 1</data></R>"
+                     "</opencv_storage>"),
+               "R.data holds 'one', not a number");
+}
+
+TEST_F(FramesTest, BadMatricesAndUrPosesAreRefused) {
+  expect_error(write("15.txt", "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0\n"),
+               "holds 15 numbers; a plain 4x4 matrix has 16");
+  expect_error(write("row.txt", "1 0 0 0.1\n0 1 0 0\n0 0 1 0\n0.1 0 0 1\n"),
+               "the matrix's last row is 0.1 0 0 1, expected 0 0 0 1");
+  expect_error(write("scaled.txt", "2 0 0 0\n0 2 0 0\n0 0 2 0\n0 0 0 1\n"),
+               "the matrix's rotation is not a rotation: R^T R differs from the identity by 3");
+  expect_error(write("nan.txt", "1 0 0 nan\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"),
+               "matrix value 4 is not finite");
+  expect_error(write("rows.yaml", "- [1, 0, 0, 0]\n- [0, 1, 0]\n- [0, 0, 1, 0]\n- [0, 0, 0, 1]\n"),
+               "field 'matrix[1]' has 3 values, expected 4");
+  expect_error(write("six.txt", "0.1, 0.2, 0.3, 0, 0, 1\n"),
+               "holds 6 numbers: a UR pose is written p[x, y, z, rx, ry, rz]");
+  expect_error(write("five.txt", "p[0.1, 0.2, 0.3, 0, 0]\n"),
+               "UR pose p[...] has 5 numbers, expected 6");
+  expect_error(write("open.txt", "p[0.1, 0.2, 0.3, 0, 0, 1\n"), "has no closing ']'");
+  expect_error(write("after.txt", "p[0.1, 0.2, 0.3, 0, 0, 1] p[0, 0, 0, 0, 0, 0]\n"),
+               "text after the UR pose");
+  expect_error(write("word.txt", "p[0.1, 0.2, zero, 0, 0, 1]\n"), "must hold numbers");
+  expect_error(write("inf.txt", "p[0.1, 0.2, inf, 0, 0, 1]\n"), "UR pose value 3 is not finite");
+  // Too large for a double: refused, not read as 0 (from_chars leaves it unset).
+  expect_error(write("over.txt", "1 0 0 1e999\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"),
+               "matrix value 4 is not finite");
+  expect_error(write("long.txt", "p[0, 0, 0, 1e308, 1e308, 1e308]\n"),
+               "the rotation vector's length is not finite");
+  // A half turn and a rotation vector longer than pi are still the rotations they say.
+  const Eigen::Isometry3d T =
+      read_transform(write("ok.txt", "# flange\np [0.4, -0.1, 0.3, 0, 3.1415926535897931, 0]\n"));
+  EXPECT_LT((T.linear() - Eigen::Matrix3d(Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitY()))).norm(),
+            1e-12);
+  EXPECT_LT((T.translation() - Eigen::Vector3d(0.4, -0.1, 0.3)).norm(), 1e-15);
+}
+
 TEST_F(FramesTest, BadFilesAreInputErrorsNamingTheProblem) {
   const std::string ok_rotation = "rotation: [0, 0, 0, 1]\n";
   expect_error((dir_ / "missing.yaml").string(), "cannot read");
-  expect_error((dir_ / "calibration").string(), "no extension");
+  expect_error((dir_ / "calibration").string(), "cannot read");
   fs::create_directories(dir_ / "adir.yaml");
   expect_error((dir_ / "adir.yaml").string(), "directory");
-  expect_error(write("pose.txt", "translation: [0, 0, 0]\n" + ok_rotation), "unknown");
   expect_error(write("syntax.yaml", "translation: [0, 0\nrotation: {\n"), "YAML parse error");
   expect_error(write("syntax.json", "{\"translation\": [0, 0, 0], }"), "JSON parse error");
   expect_error(write("empty.yaml", ""), "empty");
-  expect_error(write("scalar_root.yaml", "42\n"), "mapping");
-  expect_error(write("list.json", "[1, 2, 3]"), "object");
+  expect_error(write("blank.txt", " \n\t\n"), "empty");
+  expect_error(write("scalar_root.yaml", "42\n"), "holds 1 number; a plain 4x4 matrix has 16");
+  expect_error(write("word_root.yaml", "hello\n"), "expected a mapping");
+  expect_error(write("list.json", "[1, 2, 3]"), "holds 3 numbers");
   expect_error(write("no_t.yaml", ok_rotation), "missing field 'translation'");
   expect_error(write("no_r.json", R"({"translation": [0, 0, 0]})"), "missing field 'rotation'");
+  expect_error(write("nothing.yaml", "a: 1\nb: [2]\n"), "holds no transform in a layout");
   expect_error(write("short.yaml", "translation: [0, 0]\n" + ok_rotation),
                "'translation' has 2 values, expected 3");
   expect_error(write("long.json", R"({"translation": [0, 0, 0], "rotation": [0, 0, 0, 1, 0]})"),
@@ -130,10 +348,24 @@ TEST_F(FramesTest, BadFilesAreInputErrorsNamingTheProblem) {
                "rotation[2] is not finite");
   expect_error(write("huge.json", R"({"translation": [1e999, 0, 0], "rotation": [0, 0, 0, 1]})"),
                "");  // overflow: either a parse error or "not finite", never accepted
+  expect_error(write("far.yaml", "translation: [0, 2000, 0]\n" + ok_rotation),
+               "translation[1] is 2000 m, beyond the 1000 m");
   expect_error(write("scaled.yaml", "translation: [0, 0, 0]\nrotation: [0, 0, 0, 1.2]\n"),
                "rotation quaternion is not unit (norm 1.2)");
   expect_error(write("zero.json", R"({"translation": [0, 0, 0], "rotation": [0, 0, 0, 0]})"),
                "rotation quaternion is not unit (norm 0)");
+  expect_error(write("twice.yaml", "translation: [0, 0, 0]\n" + ok_rotation + ok_rotation),
+               "key 'rotation' appears twice");
+  expect_error(write("twice.json", R"({"translation": [0, 0, 0], "rotation": [0, 0, 0, 1],)"
+                                   R"( "translation": [1, 0, 0]})"),
+               "key 'translation' appears twice");
+  expect_error(write("rotvec.yaml", "translation: [0, 0, 0]\nrotation: [0, 0, 1]\n"),
+               "rotation vector or Euler angles are not accepted");
+  expect_error(write("two_rotations.yaml",
+                     "translation: [0, 0, 0]\n" + ok_rotation + "quaternion_wxyz: [1, 0, 0, 0]\n"),
+               "both 'rotation' and 'quaternion_wxyz'");
+  expect_error(write("extra_field.yaml", "translation: {x: 0, y: 0, z: 0, w: 1}\n" + ok_rotation),
+               "'translation' has an unexpected key 'w'");
 }
 
 TEST_F(FramesTest, TransformTrajectoryMatchesHandComputation) {

@@ -116,9 +116,13 @@ TEST(ConfigFile, APathThatIsNotUtf8StillMakesJson) {
   // fuzz_config_yaml: nlohmann's type_error on the invalid byte escaped validate (exit 5).
   Params p;
   apply_config_file(p, config_file("bytes.yaml", "hand_eye: he\xff.yaml\nflange_pose: fp.yaml\n"));
-  EXPECT_EQ(p.hand_eye_file, "he\xff.yaml");
+  EXPECT_EQ(std::filesystem::path(p.hand_eye_file).filename(), "he\xff.yaml");
   EXPECT_NO_THROW(validate(p));
-  EXPECT_EQ(nlohmann::json::parse(params_json(p))["hand_eye"], "he\xef\xbf\xbd.yaml");
+  // report.json shows the path absolute, taken from the config file's folder.
+  const std::string folder =
+      std::filesystem::path(::testing::TempDir()).lexically_normal().string();
+  EXPECT_EQ(nlohmann::json::parse(params_json(p))["hand_eye"],
+            (std::filesystem::path(folder) / "he\xef\xbf\xbd.yaml").string());
 }
 
 TEST(ConfigFile, ErrorsQuotingTheFileStayOneLine) {
@@ -126,6 +130,110 @@ TEST(ConfigFile, ErrorsQuotingTheFileStayOneLine) {
   EXPECT_NE(config_error<UsageError>("nl.yaml", "radius: \"1\\n2\"\n").find("radius"),
             std::string::npos);
   EXPECT_NE(config_error<UsageError>("nl.json", "{\"a\\nb\": 1}").find("unknown parameter 'a?b'"),
+            std::string::npos);
+}
+
+TEST(ConfigFile, PathsAreTheConfigFilesFolders) {
+  const auto sub = (std::filesystem::path(::testing::TempDir()) / "groovetrace_cfg_sub" / "cell")
+                       .lexically_normal();
+  std::filesystem::create_directories(sub);
+  const auto cfg = sub / "run.yaml";
+  std::ofstream(cfg) << "hand_eye: calib/he.yaml\nflange_pose: /abs/fp.txt\n";
+  Params p;
+  apply_config_file(p, cfg.string());
+  EXPECT_EQ(p.hand_eye_file, (sub / "calib" / "he.yaml").string());
+  EXPECT_EQ(p.flange_pose_file, "/abs/fp.txt");  // absolute: kept
+  // A config named relatively (no folder): the path stays relative to the same folder, the
+  // working directory.
+  Params q;
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(sub);
+  apply_config_file(q, "run.yaml");
+  std::filesystem::current_path(cwd);
+  EXPECT_EQ(q.hand_eye_file, "calib/he.yaml");
+  // JSON too, and a flag is not a config: set_param keeps its path as given.
+  const auto json = sub / "run.json";
+  std::ofstream(json) << R"({"hand_eye": "../he.json", "flange_pose": "fp.json"})";
+  Params r;
+  apply_config_file(r, json.string());
+  EXPECT_EQ(r.hand_eye_file, (sub.parent_path() / "he.json").string());
+  EXPECT_EQ(r.flange_pose_file, (sub / "fp.json").string());
+  set_param(r, "hand_eye", "x/he.yaml");
+  EXPECT_EQ(r.hand_eye_file, "x/he.yaml");
+}
+
+TEST(ConfigFile, NullUnsetsOptionalValuesOnly) {
+  Params p;
+  set_param(p, "viewpoint", "0,0,1");
+  set_param(p, "slices", "20");
+  set_param(p, "hand_eye", "he.yaml");
+  apply_config_file(
+      p, config_file("nulls.json", R"({"viewpoint": null, "slices": null, "hand_eye": null})"));
+  EXPECT_FALSE(p.viewpoint.has_value());
+  EXPECT_EQ(p.paper.slices, 50);
+  EXPECT_EQ(p.robust.slices, 0);
+  EXPECT_EQ(p.hand_eye_file, "");
+  Params q;
+  set_param(q, "viewpoint", "0,0,1");
+  apply_config_file(q, config_file("nulls.yaml", "viewpoint: null\nflange_pose: ~\nslices:\n"));
+  EXPECT_FALSE(q.viewpoint.has_value());
+  EXPECT_NE(config_error<UsageError>("null_speed.json", R"({"weld_speed": null})")
+                .find(": weld_speed: null is no value here"),
+            std::string::npos);
+  EXPECT_NE(config_error<UsageError>("null_key.yaml", "no_such_key: null\n")
+                .find("unknown parameter 'no_such_key'"),
+            std::string::npos);
+}
+
+TEST(Params, JsonShowsTheChosenMethodsSlices) {
+  Params robust;
+  EXPECT_EQ(nlohmann::json::parse(params_json(robust))["slices"], nullptr);  // robust: step
+  Params paper;
+  paper.method = Method::paper;
+  EXPECT_EQ(nlohmann::json::parse(params_json(paper))["slices"], 50);
+  set_param(robust, "slices", "30");
+  EXPECT_EQ(nlohmann::json::parse(params_json(robust))["slices"], 30);
+}
+
+// report.json's parameters, fed back, give the same Params: every spec's value, both methods,
+// with and without the optional ones. The report itself is a config file too.
+TEST(ConfigFile, ReportParametersGiveTheSameParams) {
+  Params a;
+  Params b;
+  b.method = Method::paper;
+  set_param(b, "viewpoint", "0.1,-0.2,0.3");
+  set_param(b, "threshold", "auto");
+  set_param(b, "slices", "40");
+  set_param(b, "units", "mm");
+  set_param(b, "hand_eye", "he.yaml");
+  set_param(b, "flange_pose", "/abs/fp.yaml");
+  Params c;
+  set_param(c, "slices", "25");
+  set_param(c, "step", "0.003");
+  set_param(c, "smooth", "false");
+  for (const Params* given : {&a, &b, &c}) {
+    const std::string json = params_json(*given);
+    const std::string report =
+        R"({"version": "x", "status": "ok", "exit_code": 0, "parameters": )" + json + "}";
+    for (const auto& [name, text] :
+         {std::pair<std::string, std::string>{"params.json", json}, {"report.json", report}}) {
+      Params back;
+      back.robust.slices = 7;  // to be overwritten: null must unset it
+      const auto keys = apply_config_file(back, config_file(name, text));
+      EXPECT_EQ(params_json(back), json) << name;
+      EXPECT_EQ(back.robust.slices, given->robust.slices) << name;
+      EXPECT_EQ(back.paper.slices, given->paper.slices) << name;
+      EXPECT_EQ(back.viewpoint.has_value(), given->viewpoint.has_value()) << name;
+      // Only keys away from their defaults count (no warning for the other method's).
+      for (const auto& k : keys) {
+        EXPECT_NE(k, "radius") << name;
+        EXPECT_NE(k, "max_seams") << name;
+      }
+    }
+  }
+  EXPECT_NE(config_error<InputError>("failed.json", R"({"status": "invalid_input", "exit_code": 3,)"
+                                                    R"( "message": "x", "outputs": []})")
+                .find("is a groovetrace report without parameters"),
             std::string::npos);
 }
 

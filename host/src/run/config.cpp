@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "io/text.hpp"
@@ -137,9 +139,12 @@ ParamSpec integer(ParamScope scope, const std::string& key, const std::string& h
 }
 template <class F>
 ParamSpec boolean(const std::string& key, const std::string& help, F field) {
-  return {key, help + ": true or false", ParamScope::common,
+  return {key,
+          help,
+          ParamScope::common,
           [=](Params& p, const std::string& t) { field.of(p) = parse_bool(key, t); },
-          [=](const Params& p) { return std::string(field.of(p) ? "true" : "false"); }};
+          [=](const Params& p) { return std::string(field.of(p) ? "true" : "false"); },
+          true};
 }
 ParamSpec choice(const std::string& key, const std::string& help, std::string Params::*field,
                  std::vector<std::string> allowed) {
@@ -147,14 +152,23 @@ ParamSpec choice(const std::string& key, const std::string& help, std::string Pa
           [=](Params& p, const std::string& t) { p.*field = one_of(key, t, allowed); },
           [=](const Params& p) { return quoted(p.*field); }};
 }
+// A file path; report.json shows it absolute, so that the report, as a config file, finds it.
 ParamSpec path(const std::string& key, const std::string& help, std::string Params::*field) {
-  return {
-      key, help, ParamScope::common,
-      [=](Params& p, const std::string& t) {
-        if (trim(t).empty()) throw UsageError(key + ": expected a file path");
-        p.*field = t;
-      },
-      [=](const Params& p) { return (p.*field).empty() ? std::string("null") : quoted(p.*field); }};
+  return {key,
+          help,
+          ParamScope::common,
+          [=](Params& p, const std::string& t) {
+            if (trim(t).empty()) throw UsageError(key + ": expected a file path");
+            p.*field = t;
+          },
+          [=](const Params& p) {
+            if ((p.*field).empty()) return std::string("null");
+            std::error_code ec;
+            const auto absolute = std::filesystem::absolute(p.*field, ec).lexically_normal();
+            return quoted(ec ? p.*field : absolute.string());
+          },
+          [=](Params& p) { (p.*field).clear(); },
+          true};
 }
 
 Eigen::Vector3f parse_viewpoint(const std::string& t) {
@@ -187,7 +201,7 @@ void add_common_specs(std::vector<ParamSpec>& s) {
   s.push_back(choice("backend", "feature backend: auto, cpu or opencl", &Params::backend,
                      {"auto", "cpu", "opencl"}));
   s.push_back({"device",
-               "OpenCL device: its index N or part of its name; default: first GPU, "
+               "OpenCL device: its index N or part of its name; none: first GPU, "
                "else first device",
                kCommon, [](Params& p, const std::string& t) { p.device = trim(t); },
                [](const Params& p) { return quoted(p.device); }});
@@ -234,17 +248,27 @@ void add_detection_specs(std::vector<ParamSpec>& s) {
 }
 
 // Waypoints: `slices` is both methods' (paper: always, default 50; robust: only when given,
-// else `step`), so it sets both; report.json shows the paper method's value.
+// else `step`), so it sets both; report.json shows the chosen method's own value (null: the
+// robust method's `step`), which set back gives the same run.
 void add_waypoint_specs(std::vector<ParamSpec>& s) {
   constexpr auto kRobust = ParamScope::robust;
   constexpr auto kPaper = ParamScope::paper;
   s.push_back({"slices",
-               "slices along the groove, one waypoint each (robust: given, it wins over step)",
+               "slices along the groove, one waypoint each (paper: 50 if not given; robust: "
+               "given, it wins over step)",
                ParamScope::common,
                [](Params& p, const std::string& t) {
                  p.paper.slices = p.robust.slices = int_in_range("slices", t, 2, 100000);
                },
-               [](const Params& p) { return std::to_string(p.paper.slices); }});
+               [](const Params& p) {
+                 if (p.method == Method::paper) return std::to_string(p.paper.slices);
+                 return p.robust.slices == 0 ? std::string("null")
+                                             : std::to_string(p.robust.slices);
+               },
+               [](Params& p) {
+                 p.paper.slices = PaperParams().slices;
+                 p.robust.slices = RobustParams().slices;
+               }});
   s.push_back(length(kRobust, "step", "robust: waypoint spacing along the seam",
                      robust(&RobustParams::step), 1e-4, 0.1));
   s.push_back(
@@ -278,10 +302,8 @@ void add_program_specs(std::vector<ParamSpec>& s) {
                "program.dat)",
                kCommon, [](Params& p, const std::string& t) { p.program.robot = parse_robot(t); },
                [](const Params& p) { return quoted(to_string(p.program.robot)); }});
-  s.push_back(
-      {"dry_run", "the same program with the arc never switched on", kCommon,
-       [](Params& p, const std::string& t) { p.program.dry_run = parse_bool("dry_run", t); },
-       [](const Params& p) { return std::string(p.program.dry_run ? "true" : "false"); }, true});
+  s.push_back(boolean("dry_run", "the same program with the arc never switched on",
+                      program(&ProgramParams::dry_run)));
   s.push_back(length(kCommon, "approach_offset", "approach and retreat distance along -tool z",
                      program(&ProgramParams::approach_offset), 0.0, 1.0));
   s.push_back(real(kCommon, "approach_speed", "approach and retreat speed",
@@ -376,19 +398,19 @@ std::vector<ParamSpec> build_specs() {
   add_common_specs(s);
   add_paper_specs(s);
   s.push_back({"viewpoint",
-               "sensor origin X,Y,Z in the cloud's frame (m); default: PCD "
+               "sensor origin X,Y,Z in the cloud's frame (m); none: PCD "
                "VIEWPOINT, else the origin",
                ParamScope::common,
                [](Params& p, const std::string& t) { p.viewpoint = parse_viewpoint(t); },
-               viewpoint_json});
+               viewpoint_json, [](Params& p) { p.viewpoint.reset(); }});
   add_detection_specs(s);
   add_waypoint_specs(s);
   add_program_specs(s);
   add_weld_specs(s);
   add_guard_specs(s);
-  s.push_back(
-      path("hand_eye", "T_flange_camera file (YAML/JSON, docs/frames.md)", &Params::hand_eye_file));
-  s.push_back(path("flange_pose", "T_base_flange at capture (YAML/JSON, docs/frames.md)",
+  s.push_back(path("hand_eye", "T_flange_camera file (any layout of docs/frames.md)",
+                   &Params::hand_eye_file));
+  s.push_back(path("flange_pose", "T_base_flange at capture (any layout of docs/frames.md)",
                    &Params::flange_pose_file));
   return s;
 }
@@ -430,9 +452,117 @@ void set_param(Params& params, const std::string& key, const std::string& value)
 
 namespace {
 
+namespace fs = std::filesystem;
+
+// One key: value of a config file; nullopt for a null.
+using Entry = std::pair<std::string, std::optional<std::string>>;
+
 // A YAML key for a message: its text, or "a key" when it is no scalar.
 std::string shown_key(const YAML::Node& key) {
   return key.IsScalar() ? io::shown(key.Scalar(), 100) : std::string("a key");
+}
+
+// A report.json (or its YAML twin) holds the run's parameters under `parameters`; a failed
+// run's report has none.
+template <class Contains>
+void require_parameters(const std::string& path, bool has_parameters, Contains contains) {
+  if (!has_parameters && contains("status") && contains("exit_code")) {
+    throw InputError("config file " + path +
+                     " is a groovetrace report without parameters (a failed run's)");
+  }
+}
+
+std::vector<Entry> json_entries(const std::string& path, const std::string& text) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError("config file " + path + " is not valid JSON");
+  }
+  if (!j.is_object()) throw InputError("config file " + path + " must hold a JSON object");
+  const bool report = j.contains("parameters") && j["parameters"].is_object();
+  require_parameters(path, report, [&](const char* k) { return j.contains(k); });
+  std::vector<Entry> entries;
+  for (const auto& [k, v] : (report ? j["parameters"] : j).items()) {
+    if (v.is_null()) {
+      entries.emplace_back(k, std::nullopt);
+    } else if (v.is_string()) {
+      entries.emplace_back(k, v.get<std::string>());
+    } else if (v.is_array()) {
+      std::string joined;
+      for (const auto& e : v) joined += (joined.empty() ? "" : ",") + e.dump();
+      entries.emplace_back(k, joined);
+    } else {
+      entries.emplace_back(k, v.dump());
+    }
+  }
+  return entries;
+}
+
+std::vector<Entry> yaml_entries(const std::string& path, const std::string& text) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const std::exception& e) {
+    throw InputError("config file " + path + " is not valid YAML");
+  }
+  if (root.IsNull()) return {};
+  if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
+  const bool report = root["parameters"] && root["parameters"].IsMap();
+  require_parameters(path, report, [&](const char* k) { return bool(root[k]); });
+  std::vector<Entry> entries;
+  for (const auto& kv : report ? root["parameters"] : root) {
+    // A key or list element that is itself a list or map is no value (yaml-cpp's "bad
+    // conversion" was exit 5). Only a list is searched for them: a map's entries are no
+    // nodes, and asking one IsScalar() threw YAML::InvalidNode (exit 5 too).
+    const bool scalars =
+        kv.second.IsSequence() && std::all_of(kv.second.begin(), kv.second.end(),
+                                              [](const YAML::Node& e) { return e.IsScalar(); });
+    const bool null = kv.second.IsNull();
+    if (!kv.first.IsScalar() || !(kv.second.IsScalar() || scalars || null)) {
+      throw UsageError("config file " + path + ": " + shown_key(kv.first) +
+                       " must be a value or a list of values");
+    }
+    const std::string k = kv.first.as<std::string>();
+    if (null) {
+      entries.emplace_back(k, std::nullopt);
+    } else if (kv.second.IsSequence()) {
+      std::string joined;
+      for (const auto& e : kv.second) joined += (joined.empty() ? "" : ",") + e.as<std::string>();
+      entries.emplace_back(k, joined);
+    } else {
+      entries.emplace_back(k, kv.second.as<std::string>());
+    }
+  }
+  return entries;
+}
+
+const ParamSpec* find_spec(const std::string& key) {
+  for (const auto& spec : param_specs()) {
+    if (spec.key == key) return &spec;
+  }
+  return nullptr;
+}
+
+// One entry: a null unsets an optional parameter; a relative file path is the config
+// folder's.
+void apply_entry(Params& params, const Entry& entry, const fs::path& folder) {
+  const auto& [key, value] = entry;
+  const ParamSpec* spec = find_spec(underscored(key));
+  if (!value) {
+    if (!spec) throw UsageError("unknown parameter '" + io::shown(key, 100) + "'");
+    if (!spec->unset) {
+      throw UsageError(spec->key + ": null is no value here (only an optional parameter " +
+                       "takes null: viewpoint, slices, a file)");
+    }
+    spec->unset(params);
+    return;
+  }
+  std::string text = *value;
+  if (spec && spec->file_path && !trim(text).empty() && fs::path(text).is_relative()) {
+    text = (folder / text).lexically_normal().string();
+  }
+  set_param(params, key, text);
 }
 
 }  // namespace
@@ -440,68 +570,30 @@ std::string shown_key(const YAML::Node& key) {
 std::vector<std::string> apply_config_file(Params& params, const std::string& path) {
   const std::string text = io::read_all(path, true);
   io::require_shallow(text, path);
-  std::vector<std::pair<std::string, std::string>> entries;
-  const auto dot = path.find_last_of('.');
-  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  const std::string ext = io::lower_extension(path);
+  std::vector<Entry> entries;
   if (ext == ".json") {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(text);
-    } catch (const std::exception& e) {
-      throw InputError("config file " + path + " is not valid JSON");
-    }
-    if (!j.is_object()) throw InputError("config file " + path + " must hold a JSON object");
-    for (const auto& [k, v] : j.items()) {
-      if (v.is_string()) {
-        entries.emplace_back(k, v.get<std::string>());
-      } else if (v.is_array()) {
-        std::string joined;
-        for (const auto& e : v) joined += (joined.empty() ? "" : ",") + e.dump();
-        entries.emplace_back(k, joined);
-      } else {
-        entries.emplace_back(k, v.dump());
-      }
-    }
+    entries = json_entries(path, text);
   } else if (ext == ".yaml" || ext == ".yml") {
-    YAML::Node root;
-    try {
-      root = YAML::Load(text);
-    } catch (const std::exception& e) {
-      throw InputError("config file " + path + " is not valid YAML");
-    }
-    if (root.IsNull()) return {};
-    if (!root.IsMap()) throw InputError("config file " + path + " must hold a YAML map");
-    for (const auto& kv : root) {
-      // A key or list element that is itself a list or map is no value (yaml-cpp's "bad
-      // conversion" was exit 5). Only a list is searched for them: a map's entries are no
-      // nodes, and asking one IsScalar() threw YAML::InvalidNode (exit 5 too).
-      const bool scalars =
-          kv.second.IsSequence() && std::all_of(kv.second.begin(), kv.second.end(),
-                                                [](const YAML::Node& e) { return e.IsScalar(); });
-      if (!kv.first.IsScalar() || !(kv.second.IsScalar() || scalars)) {
-        throw UsageError("config file " + path + ": " + shown_key(kv.first) +
-                         " must be a value or a list of values");
-      }
-      const std::string k = kv.first.as<std::string>();
-      if (kv.second.IsSequence()) {
-        std::string joined;
-        for (const auto& e : kv.second) joined += (joined.empty() ? "" : ",") + e.as<std::string>();
-        entries.emplace_back(k, joined);
-      } else {
-        entries.emplace_back(k, kv.second.as<std::string>());
-      }
-    }
+    entries = yaml_entries(path, text);
   } else {
     throw InputError("config file " + path + " must end in .yaml, .yml or .json");
   }
-  std::vector<std::string> keys;
-  for (const auto& [k, v] : entries) {
+  const fs::path folder = fs::path(path).parent_path();
+  for (const auto& entry : entries) {
     try {
-      set_param(params, k, v);
+      apply_entry(params, entry, folder);
     } catch (const UsageError& e) {
       throw UsageError("config file " + path + ": " + e.what());
     }
-    keys.push_back(underscored(k));
+  }
+  // The keys whose value differs from the default: report.json, as a config, lists every
+  // key, the other method's at their defaults, and those need no warning.
+  const Params defaults;
+  std::vector<std::string> keys;
+  for (const auto& entry : entries) {
+    const ParamSpec* spec = find_spec(underscored(entry.first));
+    if (spec && spec->json(params) != spec->json(defaults)) keys.push_back(spec->key);
   }
   return keys;
 }
