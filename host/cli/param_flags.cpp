@@ -33,11 +33,13 @@ void add_param_flags(CLI::App* sub, const std::shared_ptr<ParamFlags>& given) {
                   "YAML or JSON file of parameters, or a report.json (flags win)");
   for (const auto& spec : param_specs()) {
     const std::string key = spec.key;
-    if (spec.flag) {  // a switch: given means on (--key=false: off), and it takes no value
+    if (spec.flag) {  // a switch: given means on, and it takes no value
       sub->add_flag_function(
-          "--" + dashed(key),
-          [given, key](std::int64_t count) { given->flags[key] = count > 0 ? "true" : "false"; },
-          spec.help + default_note(spec));
+             "--" + dashed(key), [given, key](std::int64_t) { given->flags[key] = "true"; },
+             spec.help + default_note(spec))
+          // "--key=value" is refused as a usage error: CLI11 converted "perhaps" with stoll and
+          // its std::invalid_argument aborted the program.
+          ->disable_flag_override();
       continue;
     }
     sub->add_option_function<std::string>(

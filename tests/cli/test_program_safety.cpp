@@ -54,7 +54,7 @@ TEST_F(ProgramSafety, CameraCoordinatesGiveNoProgramUnlessAsked) {
   EXPECT_TRUE(has_warning(report(), "no robot program written"));
   EXPECT_TRUE(report()["programs"][0]["file"].is_null());
 
-  r = run("--camera-frame-program=true");
+  r = run("--camera-frame-program");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(out() / "program.script"));
   EXPECT_NE(r.err.find("the robot program is in camera coordinates"), std::string::npos) << r.err;
@@ -111,7 +111,7 @@ TEST_F(ProgramSafety, WrongWeldAndGuardValuesAreUsageErrors) {
 // A 10 mm wide, 4 mm deep V (20 mm^2) with 8 mm^2 beads: report.json lists the passes, the
 // root first and the cap last, each as long as the seam.
 TEST_F(ProgramSafety, MultiPassIsReportedPassByPass) {
-  const auto r = run(calibration() + " --multi-pass=true --bead-area 8e-6");
+  const auto r = run(calibration() + " --multi-pass --bead-area 8e-6");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json passes = report()["programs"][0]["passes"];
   ASSERT_GE(passes.size(), 3u) << passes.dump();

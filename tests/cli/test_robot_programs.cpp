@@ -24,8 +24,9 @@ class CliRobot : public ::testing::Test {
     write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));
   }
   test::CliResult run(const fs::path& out, const std::string& flags) {
-    return test::run_cli(
-        "run " + scan_.string() + " -o " + out.string() + " --backend cpu -q " + flags, dir_);
+    return test::run_cli("run " + scan_.string() + " -o " + out.string() +
+                             " --backend cpu -q --camera-frame-program " + flags,
+                         dir_);
   }
   /// One line on stderr, exit 2, and no program: OUTDIR holds the failure's report.json
   /// alone (a value refused), or is not made (a command line CLI11 refuses).

@@ -56,7 +56,7 @@ TEST_F(CliRobust, GrooveOnABoxWithReportedCandidates) {
   const fs::path out = dir_ / "out";
   // robust is the default method.
   const auto r = test::run_cli(
-      "run " + scan.string() + " -o " + out.string() + " --camera-frame-program=true", dir_);
+      "run " + scan.string() + " -o " + out.string() + " --camera-frame-program", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   for (const char* f : {"annotated.pcd", "overview.png", "trajectory.csv", "trajectory.json",
                         "program.script", "report.json"}) {
@@ -145,7 +145,7 @@ TEST_F(CliRobust, StepSlicesAndMaxSeams) {
       "two.pcd");
   const auto r = test::run_cli("run " + scan.string() + " -o " + (dir_ / "a").string() +
                                    " --method robust --max-seams 2 --step 0.004 -q "
-                                   "--camera-frame-program=true",
+                                   "--camera-frame-program",
                                dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("seams found"), std::string::npos) << r.err;  // both exported

@@ -56,7 +56,7 @@ class CliRun : public ::testing::Test {
 TEST_F(CliRun, StraightGrooveProducesAllOutputsAlongTheGroove) {
   const fs::path out = dir_ / "out";
   const auto r = test::run_cli("run " + scan_.string() + " -o " + out.string() +
-                                   " --method paper --backend cpu --camera-frame-program=true",
+                                   " --method paper --backend cpu --camera-frame-program",
                                dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("outputs in"), std::string::npos) << r.out;

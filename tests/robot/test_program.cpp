@@ -296,7 +296,10 @@ TEST(ProgramSettings, RobotAndDryRunAreParameters) {
   EXPECT_THROW(set_param(p, "dry_run", "maybe"), UsageError);
   EXPECT_THROW(set_param(p, "arc_output", "4097"), UsageError);
   for (const ParamSpec& spec : param_specs()) {
-    EXPECT_EQ(spec.flag, spec.key == "dry_run") << spec.key;  // the one switch
+    // The switches: off by default, given without a value.
+    EXPECT_EQ(spec.flag, spec.key == "dry_run" || spec.key == "multi_pass" ||
+                             spec.key == "camera_frame_program")
+        << spec.key;
   }
 }
 

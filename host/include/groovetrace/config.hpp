@@ -21,14 +21,14 @@ struct GT_API ParamSpec {
   std::function<void(Params&, const std::string&)> set;
   /// The current value as a JSON literal (number, string, bool, array or null).
   std::function<std::string(const Params&)> json;
-  /// A switch that is off by default: on the command line a flag without a value
-  /// (`--dry-run` sets "true"); in a config file `key: true` or `key: false`.
-  bool flag = false;
   /// Back to "not given" (the default), for a null in a config file; empty when the
   /// parameter has no such state (a null is then refused).
   std::function<void(Params&)> unset = nullptr;
   /// A file path: in a config file, relative to the config file's folder.
   bool file_path = false;
+  /// A switch that is off by default: on the command line a flag without a value
+  /// (`--dry-run` sets "true"); in a config file `key: true` or `key: false`.
+  bool flag = false;
 };
 
 /// Every parameter, in documentation order.

@@ -144,6 +144,8 @@ ParamSpec boolean(const std::string& key, const std::string& help, F field) {
           ParamScope::common,
           [=](Params& p, const std::string& t) { field.of(p) = parse_bool(key, t); },
           [=](const Params& p) { return std::string(field.of(p) ? "true" : "false"); },
+          nullptr,
+          false,
           true};
 }
 ParamSpec choice(const std::string& key, const std::string& help, std::string Params::*field,
@@ -387,7 +389,7 @@ void add_guard_specs(std::vector<ParamSpec>& s) {
                "needs --hand-eye and --flange-pose",
                kCommon,
                [](Params& p, const std::string& t) { p.guards.workspace = parse_workspace(t); },
-               workspace_json});
+               workspace_json, [](Params& p) { p.guards.workspace.reset(); }});
   s.push_back(boolean("camera_frame_program",
                       "write the robot program even when its poses are in the camera frame",
                       guard(&GuardParams::camera_frame_program)));
