@@ -241,6 +241,9 @@ TEST_F(DepthPng, AHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
   EXPECT_NE(with_size(0, 10).find("at most 16384"), std::string::npos);
   // A size the file could hold but does not: libpng finds the data short.
   EXPECT_NE(with_size(kW, kH + 8).find("truncated or corrupt"), std::string::npos);
+  // Intrinsics for another size refuse it before the pixels are decoded.
+  write_text(dir_ / "scan.json", json_of(Pinhole{}, ", \"width\": 64, \"height\": 48"));
+  EXPECT_NE(with_size(kW, kH + 8).find("is 64x56 but its intrinsics"), std::string::npos);
 }
 
 }  // namespace

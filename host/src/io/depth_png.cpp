@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <groovetrace/error.hpp>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "io/text.hpp"
 
@@ -93,19 +95,26 @@ bool read_rows(png_structp png, png_infop info, std::vector<png_bytep>& row_poin
 
 }  // namespace
 
-DepthImage decode_depth_png(const std::string& bytes, const std::string& path) {
+std::pair<std::uint32_t, std::uint32_t> depth_png_size(const std::string& bytes,
+                                                       const std::string& path) {
   try {
     check_header(bytes);
   } catch (const Rejected& r) {
     throw InputError(shown(path) + " " + r.what);  // every reason above starts with a verb
   }
+  return {be32(bytes, 16), be32(bytes, 20)};
+}
+
+DepthImage decode_depth_png(const std::string& bytes, const std::string& path) {
   DepthImage image;
-  image.width = be32(bytes, 16);
-  image.height = be32(bytes, 20);
+  std::tie(image.width, image.height) = depth_png_size(bytes, path);
+  // libpng writes the rows' big-endian samples straight into the depth array; they are put
+  // in host order afterwards, in place (one buffer: 2 bytes per pixel).
+  image.depth.resize(static_cast<std::size_t>(image.width) * image.height);
+  auto* raw = reinterpret_cast<png_bytep>(image.depth.data());
   const std::size_t stride = 2 * static_cast<std::size_t>(image.width);
-  std::vector<png_byte> raw(stride * image.height);
   std::vector<png_bytep> rows(image.height);
-  for (std::size_t r = 0; r < rows.size(); ++r) rows[r] = raw.data() + r * stride;
+  for (std::size_t r = 0; r < rows.size(); ++r) rows[r] = raw + r * stride;
 
   Source src{bytes, 0, ""};
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, &on_error, &on_warning);
@@ -119,7 +128,6 @@ DepthImage decode_depth_png(const std::string& bytes, const std::string& path) {
   const bool ok = read_rows(png, info, rows);
   png_destroy_read_struct(&png, &info, nullptr);
   if (!ok) throw InputError(shown(path) + ": truncated or corrupt PNG data (" + src.error + ")");
-  image.depth.resize(static_cast<std::size_t>(image.width) * image.height);
   for (std::size_t i = 0; i < image.depth.size(); ++i) {
     image.depth[i] = static_cast<std::uint16_t>((raw[2 * i] << 8) | raw[2 * i + 1]);
   }
@@ -171,7 +179,8 @@ void check_points(const Cloud& cloud, const std::string& path, std::size_t min_v
 
 Cloud read_depth_png(const std::string& path, const std::string& content,
                      const std::string& intrinsics_path, std::size_t min_valid) {
-  const DepthImage image = decode_depth_png(content, path);
+  // The header and the intrinsics are checked before the pixels are decoded.
+  const auto [width, height] = depth_png_size(content, path);
   const std::string found = find_depth_intrinsics(path, intrinsics_path);
   if (found.empty()) {
     const std::string sidecar = std::filesystem::path(path).stem().string() + ".json";
@@ -180,14 +189,14 @@ Cloud read_depth_png(const std::string& path, const std::string& content,
                      shown(sidecar, 200) + " or intrinsics.json beside it");
   }
   const DepthIntrinsics k = parse_depth_intrinsics(read_all(found), found);
-  const bool w_ok = k.width == 0 || k.width == image.width;
-  const bool h_ok = k.height == 0 || k.height == image.height;
+  const bool w_ok = k.width == 0 || k.width == width;
+  const bool h_ok = k.height == 0 || k.height == height;
   if (!w_ok || !h_ok) {
-    throw InputError(shown(path) + " is " + std::to_string(image.width) + "x" +
-                     std::to_string(image.height) + " but its intrinsics " + shown(found) +
-                     " are for " + std::to_string(k.width) + "x" + std::to_string(k.height));
+    throw InputError(shown(path) + " is " + std::to_string(width) + "x" + std::to_string(height) +
+                     " but its intrinsics " + shown(found) + " are for " + std::to_string(k.width) +
+                     "x" + std::to_string(k.height));
   }
-  Cloud cloud = depth_to_cloud(image, k);
+  Cloud cloud = depth_to_cloud(decode_depth_png(content, path), k);
   check_points(cloud, path, min_valid);
   return cloud;
 }

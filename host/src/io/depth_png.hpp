@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <groovetrace/cloud.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace groovetrace::io {
@@ -35,6 +36,11 @@ DepthIntrinsics parse_depth_intrinsics(const std::string& text, const std::strin
 /// The intrinsics file of the depth PNG `png`: `given` when not empty, else STEM.json beside
 /// it (scan.png: scan.json), else intrinsics.json in its folder; "" when none exists.
 std::string find_depth_intrinsics(const std::string& png, const std::string& given);
+
+/// The image's width and height (pixels) from its header, after the header checks of
+/// decode_depth_png. Throws InputError.
+std::pair<std::uint32_t, std::uint32_t> depth_png_size(const std::string& bytes,
+                                                       const std::string& path);
 
 /// Decodes `bytes` (the file `path`) through libpng. Throws InputError for anything but a
 /// 16-bit grey PNG, a header larger than kMaxDepthSide per side or than the file can hold,
