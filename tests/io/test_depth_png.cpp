@@ -9,6 +9,7 @@
 #include <groovetrace/cloud_io.hpp>
 #include <groovetrace/error.hpp>
 
+#include "../fuzz/depth_png_seed.hpp"
 #include "support/cli_runner.hpp"
 #include "support/depth_png_writer.hpp"
 
@@ -244,6 +245,23 @@ TEST_F(DepthPng, AHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
   // Intrinsics for another size refuse it before the pixels are decoded.
   write_text(dir_ / "scan.json", json_of(Pinhole{}, ", \"width\": 64, \"height\": 48"));
   EXPECT_NE(with_size(kW, kH + 8).find("is 64x56 but its intrinsics"), std::string::npos);
+}
+
+TEST_F(DepthPng, AFileBuiltWithoutLibpngReadsBack) {
+  // The fuzzers' seed, built byte by byte (a zlib stored block, no libpng): an independent
+  // encoder of an 8x6 image of depth 1000.
+  write_text(dir_ / "seed.png", fuzz::small_depth_png());
+  write_text(dir_ / "intrinsics.json", json_of({60, 55, 3.5, 2.5, 0.001}));
+  ReadOptions ro;
+  ro.min_valid_points = 48;
+  const Cloud cloud = read_cloud((dir_ / "seed.png").string(), ro);
+  ASSERT_EQ(cloud.size(), 48u);
+  ASSERT_EQ(cloud.width, 8u);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    EXPECT_NEAR(cloud.z[i], 1.0, 1e-6);
+    EXPECT_NEAR(cloud.x[i], (static_cast<double>(i % 8) - 3.5) / 60.0, 1e-6);
+    EXPECT_NEAR(cloud.y[i], (static_cast<double>(i / 8) - 2.5) / 55.0, 1e-6);
+  }
 }
 
 }  // namespace
