@@ -49,6 +49,15 @@ struct Endpoint {
   std::string port;  // digits, 1-65535
 };
 
+// Text from the command line in a one-line message: control characters become '?'.
+std::string shown(const std::string& text) {
+  std::string out = text.substr(0, 300);
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
 // ---- HOST[:PORT] --------------------------------------------------------------------------
 
 std::string port_or_throw(const std::string& text, const std::string& robot) {
@@ -56,8 +65,8 @@ std::string port_or_throw(const std::string& text, const std::string& robot) {
                       text.find_first_not_of("0123456789") == std::string::npos;
   const long port = digits ? std::stol(text) : 0;
   if (port < 1 || port > 65535) {
-    throw UsageError("send: --robot: port must be a number 1-65535, got '" + text + "' in '" +
-                     robot + "'");
+    throw UsageError("send: --robot: port must be a number 1-65535, got '" + shown(text) +
+                     "' in '" + shown(robot) + "'");
   }
   return std::to_string(port);
 }
@@ -69,15 +78,16 @@ Endpoint parse_robot(const std::string& robot) {
   std::string rest;
   if (!robot.empty() && robot.front() == '[') {
     const auto close = robot.find(']');
-    if (close == std::string::npos) throw UsageError("send: --robot: no ']' in '" + robot + "'");
+    if (close == std::string::npos)
+      throw UsageError("send: --robot: no ']' in '" + shown(robot) + "'");
     e.host = robot.substr(1, close - 1);
     rest = robot.substr(close + 1);
     if (!rest.empty() && rest.front() != ':') {
-      throw UsageError("send: --robot: expected ':PORT' after ']' in '" + robot + "'");
+      throw UsageError("send: --robot: expected ':PORT' after ']' in '" + shown(robot) + "'");
     }
   } else if (robot.find(':') != robot.rfind(':')) {
     throw UsageError("send: --robot: write an IPv6 address in brackets, [ADDR]:PORT, got '" +
-                     robot + "'");
+                     shown(robot) + "'");
   } else if (const auto colon = robot.find(':'); colon != std::string::npos) {
     e.host = robot.substr(0, colon);
     rest = robot.substr(colon);
@@ -86,7 +96,7 @@ Endpoint parse_robot(const std::string& robot) {
   const bool bad_char = e.host.find_first_of(" \t\r\n/[]") != std::string::npos;
   if (e.host.empty() || bad_char) {
     throw UsageError("send: --robot: expected HOST[:PORT] with a host name or address, got '" +
-                     robot + "'");
+                     shown(robot) + "'");
   }
   return e;
 }
@@ -94,7 +104,7 @@ Endpoint parse_robot(const std::string& robot) {
 // ---- the program file -----------------------------------------------------------------------
 
 [[noreturn]] void refuse(const std::string& path, const std::string& why) {
-  throw InputError("send: " + path + ": " + why + "; nothing sent");
+  throw InputError("send: " + shown(path) + ": " + why + "; nothing sent");
 }
 
 std::string read_program(const std::string& path) {
@@ -250,7 +260,8 @@ struct Target {
   Endpoint endpoint;
   std::string name() const {
     const bool v6 = endpoint.host.find(':') != std::string::npos;
-    return (v6 ? "[" + endpoint.host + "]" : endpoint.host) + ":" + endpoint.port;
+    const std::string host = shown(endpoint.host);
+    return (v6 ? "[" + host + "]" : host) + ":" + endpoint.port;
   }
 };
 
@@ -374,7 +385,7 @@ int send_program(const SendOptions& o) {
   finish(s.fd, target, o.timeout_s);
   if (!o.quiet) {
     std::printf("groovetrace: sent program %s (%zu bytes, %s) to %s\n", name.c_str(), text.size(),
-                o.program.c_str(), target.name().c_str());
+                shown(o.program).c_str(), target.name().c_str());
   }
   return 0;
 }
