@@ -24,6 +24,9 @@
 #include <vector>
 
 #include "batch/jobs.hpp"
+#include "depth_png_seed.hpp"
+#include "io/depth_png.hpp"
+#include "io/text.hpp"
 
 namespace {
 
@@ -179,6 +182,19 @@ void manifest_seeds(const fs::path& dir) {
   write(dir / "scans.csv", "viewpoint,scan\n,x.pcd\r\n\"0 0 -1\",sub/x.pcd\r\n");
 }
 
+// A depth PNG (read with depth_seed_intrinsics.json, written beside the seed folders) and
+// intrinsics JSON in RealSense's spellings.
+void depth_seeds(const fs::path& png, const fs::path& json, const fs::path& out) {
+  write(png / "small.png", groovetrace::fuzz::small_depth_png());
+  write(out / "depth_seed_intrinsics.json",
+        R"({"fx": 60, "fy": 55, "ppx": 3.5, "ppy": 2.5, "depth_scale": 0.001})");
+  write(json / "plain.json",
+        R"({"fx": 60, "fy": 55, "ppx": 3.5, "ppy": 2.5, "depth_scale": 0.001})");
+  write(json / "realsense.json",
+        R"({"width": 8, "height": 6, "ppx": 3.5, "ppy": 2.5, "fx": 60.1, "fy": 59.9,)"
+        R"( "model": "distortion.brown_conrady", "coeffs": [0, 0, 0, 0, 0], "depth_scale": 1e-4})");
+}
+
 // libFuzzer dictionaries: the words each format is made of.
 void dictionaries(const fs::path& dir) {
   auto dict = [&](const char* name, const std::vector<std::string>& words) {
@@ -254,6 +270,8 @@ void dictionaries(const fs::path& dir) {
                             "-->",
                             "&amp;",
                             "\\x0a"});
+  dict("depth.dict", {"IHDR", "IDAT", "IEND", "fx", "fy", "ppx", "ppy", "depth_scale", "width",
+                      "height", "model", "coeffs", "brown_conrady", "none", "distortion."});
   dict("manifest.dict",
        {"scan", "flange_pose", "hand_eye", "viewpoint", ".pcd", ".ply", "..", "/", "\\\"", ","});
 }
@@ -275,7 +293,17 @@ bool read_back(const fs::path& seeds) {
        }},
       {"calibration_yaml", [](const std::string& p) { groovetrace::read_transform(p); }},
       {"calibration_json", [](const std::string& p) { groovetrace::read_transform(p); }},
-      {"manifest", [](const std::string& p) { groovetrace::batch::list_jobs({p}); }}};
+      {"manifest", [](const std::string& p) { groovetrace::batch::list_jobs({p}); }},
+      {"depth_png",
+       [&seeds](const std::string& p) {
+         groovetrace::ReadOptions o;
+         o.intrinsics_path = (seeds.parent_path() / "depth_seed_intrinsics.json").string();
+         o.min_valid_points = 1;
+         groovetrace::read_cloud(p, o);
+       }},
+      {"depth_intrinsics", [](const std::string& p) {
+         groovetrace::io::parse_depth_intrinsics(groovetrace::io::read_all(p), p);
+       }}};
   bool ok = true;
   for (const auto& [name, read] : readers) {
     for (const auto& entry : fs::directory_iterator(seeds / name)) {
@@ -304,6 +332,7 @@ int main(int argc, char** argv) {
   config_seeds(out / "seeds" / "config_yaml", out / "seeds" / "config_json");
   calibration_seeds(out / "seeds" / "calibration_yaml", out / "seeds" / "calibration_json");
   manifest_seeds(out / "seeds" / "manifest");
+  depth_seeds(out / "seeds" / "depth_png", out / "seeds" / "depth_intrinsics", out);
   dictionaries(out / "dicts");
   return read_back(out / "seeds") ? 0 : 1;
 }

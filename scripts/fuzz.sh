@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 all=(fuzz_pcd fuzz_ply fuzz_config_yaml fuzz_config_json fuzz_calibration_yaml
-     fuzz_calibration_json fuzz_manifest)
+     fuzz_calibration_json fuzz_manifest fuzz_depth_png fuzz_depth_intrinsics)
 harnesses=("${all[@]}")
 [ $# -eq 0 ] || harnesses=("$@")
 [[ "$seconds" =~ ^[0-9]+$ ]] || { echo "usage: scripts/fuzz.sh [SECONDS] [HARNESS...]" >&2; exit 2; }

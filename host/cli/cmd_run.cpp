@@ -44,6 +44,7 @@ int run_checked(const RunOptions& opt) {
       });
   ReadOptions ro;
   ro.units_scale = params.units_scale;
+  ro.intrinsics_path = params.intrinsics_file;
   const Cloud cloud = read_cloud(opt.scan, ro);
   const double load_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -97,7 +98,7 @@ int run(const RunOptions& opt) {
 Command add_run_command(CLI::App& app) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* sub = app.add_subcommand("run", "detect the groove in SCAN and write the outputs");
-  sub->add_option("scan", opt->scan, "input scan (.pcd or .ply)")->required();
+  sub->add_option("scan", opt->scan, "input scan (.pcd, .ply, or a 16-bit depth .png)")->required();
   sub->add_option("-o,--output", opt->out_dir, "output directory (created if missing)")->required();
   sub->add_flag("-q,--quiet", opt->quiet, "print nothing but warnings and errors");
   add_param_flags(sub, opt->params);

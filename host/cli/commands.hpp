@@ -18,5 +18,6 @@ Command add_synth_command(CLI::App& app);
 Command add_eval_command(CLI::App& app);
 Command add_batch_command(CLI::App& app);
 Command add_report_command(CLI::App& app);
+Command add_send_command(CLI::App& app);
 
 }  // namespace groovetrace::cli

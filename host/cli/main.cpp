@@ -1,5 +1,5 @@
-// groovetrace CLI: subcommands run, synth, eval. Every failure ends as one line on stderr
-// and the exit code of docs/design.md ("CLI contract").
+// groovetrace CLI: subcommands run, synth, eval, batch, report, send. Every failure ends as one
+// line on stderr and the exit code of docs/design.md ("CLI contract").
 #include <unistd.h>
 
 #include <cstdlib>
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   std::vector<groovetrace::cli::Command> commands = {
       groovetrace::cli::add_run_command(app),    groovetrace::cli::add_synth_command(app),
       groovetrace::cli::add_eval_command(app),   groovetrace::cli::add_batch_command(app),
-      groovetrace::cli::add_report_command(app),
+      groovetrace::cli::add_report_command(app), groovetrace::cli::add_send_command(app),
   };
   try {
     app.parse(argc, argv);

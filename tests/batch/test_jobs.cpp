@@ -174,5 +174,30 @@ TEST(BatchRows, JsonRoundTripAndCsvQuoting) {
   EXPECT_THROW(row_from_json("{}", "test"), InputError);
 }
 
+TEST(BatchJobs, DepthPngsCountWhereTheirIntrinsicsAreAndOutdirIsNeverSearched) {
+  const fs::path d = test::fresh_dir("batch_jobs_png");
+  touch(d / "in" / "a.png");
+  touch(d / "in" / "a.json");     // a's intrinsics
+  touch(d / "in" / "photo.png");  // none: not a scan
+  touch(d / "in" / "cell" / "intrinsics.json");
+  touch(d / "in" / "cell" / "b.png");
+  touch(d / "in" / "old_run" / "report.json");  // a run's output folder inside the input
+  touch(d / "in" / "old_run" / "overview.png");
+  touch(d / "in" / "night" / "c" / "scan.json");  // the batch's own OUTDIR inside the input
+  touch(d / "in" / "night" / "c" / "thumbnail.png");
+  touch(d / "in" / "night" / "c" / "annotated.pcd");
+  touch(d / "in" / "night" / "c" / "c.png");
+  touch(d / "in" / "night" / "c" / "c.json");
+  const std::string night = (d / "in" / "night").string();
+  EXPECT_EQ(rels(list_jobs({(d / "in").string()}, {night, false})),
+            (std::vector<std::string>{"a", "cell/b"}));
+  EXPECT_EQ(rels(list_jobs({(d / "in").string()}, {night, true})),
+            (std::vector<std::string>{"a", "cell/b", "photo"}));
+  // Without knowing OUTDIR (an older caller), its scans are found as before.
+  EXPECT_EQ(rels(list_jobs({(d / "in").string()})),
+            (std::vector<std::string>{"a", "cell/b", "night/c/annotated", "night/c/c"}));
+  fs::remove_all(d);
+}
+
 }  // namespace
 }  // namespace groovetrace::batch

@@ -396,7 +396,7 @@ TEST_F(CloudIo, UnreadableFile) {
 
 TEST_F(CloudIo, UnknownExtension) {
   const fs::path p = file("scan.xyz", "1 2 3\n");
-  expect_rejected(p, "unsupported file type ('.xyz'; expected .pcd or .ply)");
+  expect_rejected(p, "unsupported file type ('.xyz'; expected .pcd, .ply or a 16-bit depth .png)");
   expect_rejected(file("noext", "1 2 3\n"), "unsupported file type (no file extension");
 }
 

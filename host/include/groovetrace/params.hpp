@@ -139,6 +139,10 @@ struct Params {
   // Frames: robot base frame output when both are given (files, see docs/frames.md).
   std::string hand_eye_file;     ///< T_flange_camera
   std::string flange_pose_file;  ///< T_base_flange at capture time
+
+  /// Depth PNG scans: the intrinsics JSON (fx, fy, ppx, ppy in pixels, depth_scale in m per
+  /// unit); empty: STEM.json beside the PNG, else intrinsics.json in its folder.
+  std::string intrinsics_file;
 };
 
 }  // namespace groovetrace

@@ -116,7 +116,7 @@ int default_batch_jobs() {
 BatchTotals run_batch(const BatchOptions& o) {
   const auto t0 = Clock::now();
   check_options(o);
-  const auto all = batch::list_jobs(o.inputs);
+  const auto all = batch::list_jobs(o.inputs, {o.out_dir, !o.params.intrinsics_file.empty()});
   const auto mine = batch::shard(all, o.shard_index, o.shard_count);
   make_out_dir(o.out_dir);
   batch::remove_stale_partials(o.out_dir);

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "io/depth_png.hpp"
 #include "io/text.hpp"
 
 namespace groovetrace::batch {
@@ -16,9 +17,30 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool is_scan(const fs::path& p) {
+// The pictures `run` and `batch` write beside their report.json or scan.json.
+bool is_run_picture(const fs::path& p) {
+  const std::string name = p.filename().string();
+  if (name != "overview.png" && name != "thumbnail.png") return false;
+  std::error_code ec;
+  return fs::exists(p.parent_path() / "report.json", ec) ||
+         fs::exists(p.parent_path() / "scan.json", ec);
+}
+
+// A .png is a depth scan when its intrinsics are found (--intrinsics, STEM.json or
+// intrinsics.json beside it); other PNGs (photos, a run's pictures) are no scans.
+bool is_scan(const fs::path& p, const ListOptions& options) {
   const std::string ext = io::lower_extension(p.string());
+  if (ext == ".png") {
+    if (is_run_picture(p)) return false;
+    return options.intrinsics_given || !io::find_depth_intrinsics(p.string(), "").empty();
+  }
   return ext == ".pcd" || ext == ".ply";
+}
+
+// Whether `p` is the batch's own OUTDIR (when it lies inside an input folder).
+bool is_out_dir(const fs::path& p, const ListOptions& options) {
+  std::error_code ec;
+  return !options.out_dir.empty() && fs::equivalent(p, options.out_dir, ec);
 }
 
 // `groovetrace synth` writes SCAN.pcd with its ground truth beside it: SCAN.truth.json and
@@ -43,12 +65,18 @@ std::string without_extension(const fs::path& rel) {
   return (rel.parent_path() / (dots ? rel.filename() : stem)).generic_string();
 }
 
-std::vector<ScanJob> scans_in_directory(const fs::path& root) {
+std::vector<ScanJob> scans_in_directory(const fs::path& root, const ListOptions& options) {
   std::vector<ScanJob> jobs;
   std::error_code ec;
   for (auto it = fs::recursive_directory_iterator(root, ec); !ec && it != fs::end(it);
        it.increment(ec)) {
-    if (!it->is_regular_file(ec) || !is_scan(it->path()) || is_synth_labels(it->path())) continue;
+    if (it->is_directory(ec) && is_out_dir(it->path(), options)) {
+      it.disable_recursion_pending();  // the batch's own outputs are no scans
+      continue;
+    }
+    if (!it->is_regular_file(ec) || !is_scan(it->path(), options) || is_synth_labels(it->path())) {
+      continue;
+    }
     jobs.push_back({it->path().string(), without_extension(fs::relative(it->path(), root)), "", "",
                     std::nullopt});
   }
@@ -166,14 +194,14 @@ std::vector<ScanJob> read_manifest(const std::string& path) {
   return jobs;
 }
 
-std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
+std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs, const ListOptions& options) {
   std::vector<ScanJob> jobs;
   for (const std::string& input : inputs) {
     std::error_code ec;
     const fs::path p(input);
     std::vector<ScanJob> found;
     if (fs::is_directory(p, ec)) {
-      found = scans_in_directory(p);
+      found = scans_in_directory(p, options);
     } else if (fs::is_regular_file(p, ec) && io::lower_extension(p.string()) == ".csv") {
       found = read_manifest(input);
     } else if (fs::exists(p, ec)) {
@@ -183,7 +211,9 @@ std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs) {
     }
     jobs.insert(jobs.end(), found.begin(), found.end());
   }
-  if (jobs.empty()) throw InputError("no scan (.pcd or .ply) in the inputs");
+  if (jobs.empty()) {
+    throw InputError("no scan (.pcd, .ply, or .png with its intrinsics) in the inputs");
+  }
   auto by_dir = [](const ScanJob& a, const ScanJob& b) {
     return a.rel != b.rel ? a.rel < b.rel : a.path < b.path;
   };

@@ -17,11 +17,21 @@ struct ScanJob {
   std::optional<Eigen::Vector3f> viewpoint;  ///< manifest: sensor origin (cloud frame, m)
 };
 
-/// Expands directories (recursively, .pcd/.ply, sorted), scan files and manifest CSVs (.csv)
-/// into jobs sorted by `rel`. Two scans that would share a directory (x.pcd and x.ply, or the
-/// same relative path under two inputs) get the extension and then a counter appended, so no
-/// two jobs share one. Throws InputError for a missing input, a bad manifest or no scan at all.
-std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs);
+/// What a directory search needs to know besides the inputs.
+struct ListOptions {
+  std::string out_dir;            ///< the batch's OUTDIR: never searched when inside an input
+  bool intrinsics_given = false;  ///< --intrinsics: every .png found is a depth scan
+};
+
+/// Expands directories (recursively, .pcd/.ply, and .png depth images whose intrinsics are
+/// found: `options.intrinsics_given`, STEM.json or intrinsics.json beside them; never the
+/// overview.png or thumbnail.png beside a run's report.json or a batch's scan.json; sorted),
+/// scan files and manifest CSVs (.csv) into jobs sorted by `rel`. Two scans that would share a
+/// directory (x.pcd and x.ply, or the same relative path under two inputs) get the extension and
+/// then a counter appended, so no two jobs share one. Throws InputError for a missing input, a bad
+/// manifest or no scan at all.
+std::vector<ScanJob> list_jobs(const std::vector<std::string>& inputs,
+                               const ListOptions& options = {});
 
 /// Reads a manifest: header `scan[,flange_pose][,hand_eye][,viewpoint]` (any order, `scan`
 /// required), one row per scan, paths relative to the manifest's folder, viewpoint "X Y Z".

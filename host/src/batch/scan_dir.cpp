@@ -64,6 +64,7 @@ std::vector<std::pair<std::string, std::string>> run_files(const ScanJob& job, c
   const auto t0 = std::chrono::steady_clock::now();
   ReadOptions ro;
   ro.units_scale = p.units_scale;
+  ro.intrinsics_path = p.intrinsics_file;
   const Cloud cloud = read_cloud(job.path, ro);
   const double load_ms = ms_since(t0);
   RunResult result = run_pipeline(cloud, p, backend);

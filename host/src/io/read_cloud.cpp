@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "io/decode.hpp"
+#include "io/depth_png.hpp"
 #include "io/text.hpp"
 
 namespace groovetrace {
@@ -147,12 +148,16 @@ Cloud read_cloud(const std::string& path, const ReadOptions& options) {
                      std::to_string(options.units_scale));
   }
   const std::string ext = io::lower_extension(path);
-  if (ext != ".pcd" && ext != ".ply") {
+  if (ext != ".pcd" && ext != ".ply" && ext != ".png") {
     const std::string what = ext.empty() ? "no file extension" : "'" + io::shown(ext, 20) + "'";
     throw InputError("cannot read " + io::shown(path) + ": unsupported file type (" + what +
-                     "; expected .pcd or .ply)");
+                     "; expected .pcd, .ply or a 16-bit depth .png)");
   }
   const std::string content = io::read_all(path);
+  // A depth image's unit is its intrinsics' depth_scale: units_scale does not apply.
+  if (ext == ".png") {
+    return io::read_depth_png(path, content, options.intrinsics_path, options.min_valid_points);
+  }
   try {
     const io::Decoded decoded =
         ext == ".pcd" ? io::decode_pcd(content, {"x", "y", "z"}) : io::decode_ply(path, content);

@@ -414,6 +414,10 @@ std::vector<ParamSpec> build_specs() {
                    &Params::hand_eye_file));
   s.push_back(path("flange_pose", "T_base_flange at capture (any layout of docs/frames.md)",
                    &Params::flange_pose_file));
+  s.push_back(path("intrinsics",
+                   "depth PNG scans: intrinsics JSON (fx, fy, ppx, ppy px; depth_scale m/unit); "
+                   "default: STEM.json, else intrinsics.json beside the PNG",
+                   &Params::intrinsics_file));
   return s;
 }
 
