@@ -135,6 +135,24 @@ TEST_F(ProgramSafety, AWeaveIsBoundedByTheOpening) {
   EXPECT_GT(pass["length_m"].get<double>(), 1.5 * report()["trajectory"]["length_m"].get<double>());
 }
 
+// An easy_handeye eye-on-base file is T_base_camera already: with a flange pose that is not the
+// identity it would be applied twice, so the run stops (exit 3, the file named); with an
+// identity flange pose (a camera fixed in the cell) it runs.
+TEST_F(ProgramSafety, AnEyeOnBaseCalibrationNeedsAnIdentityFlangePose) {
+  std::ofstream(dir_ / "eye_on_base.yaml")
+      << "parameters:\n  eye_on_hand: false\n  robot_base_frame: base_link\n"
+         "  tracking_base_frame: camera_link\ntransformation:\n  qw: 1.0\n  qx: 0.0\n"
+         "  qy: 0.0\n  qz: 0.0\n  x: 0.0\n  y: 0.0\n  z: 0.0\n";
+  std::ofstream(dir_ / "moved.yaml") << "translation: [0.4, 0, 0.3]\nrotation: [0, 0, 0, 1]\n";
+  const std::string hand_eye = "--hand-eye " + (dir_ / "eye_on_base.yaml").string();
+  auto r = run(hand_eye + " --flange-pose " + (dir_ / "moved.yaml").string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("eye_on_base.yaml: an eye-on-base calibration"), std::string::npos) << r.err;
+  calibration();  // writes the identity flange.yaml
+  r = run(hand_eye + " --flange-pose " + (dir_ / "flange.yaml").string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 // The paper method with a zero threshold marks every point: exit 0 as before, but warned.
 TEST_F(ProgramSafety, AnImplausibleDetectionIsWarned) {
   const auto r = run("--method paper --threshold 0");

@@ -112,7 +112,7 @@ struct WeldParams {
 
 /// Checks on every robot program before it is written (guards.hpp); a violation is exit 7.
 struct GuardParams {
-  double max_step = 0.02;           ///< largest distance between consecutive poses (m)
+  double max_step = 0.05;           ///< largest distance between consecutive poses (m)
   double max_step_rotation = 30.0;  ///< largest rotation between consecutive poses (deg)
   /// Every pose, approach and retreat included, inside this box of the base frame (m); unset:
   /// no box. Needs the calibration files.

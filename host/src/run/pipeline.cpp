@@ -178,6 +178,20 @@ void guard_programs(const Cloud& cloud, const Params& params, RunResult& r) {
     check_program(passes, params.guards, params.program, viewpoint);
 }
 
+// T_base_camera = T_base_flange * T_flange_camera. An eye-on-base calibration (easy_handeye
+// says so) is already T_base_camera: with a real flange pose it would be applied twice.
+Eigen::Isometry3d read_T_base_camera(const Params& params) {
+  const Calibration hand_eye = read_calibration(params.hand_eye_file);
+  const Eigen::Isometry3d T_base_flange = read_transform(params.flange_pose_file);
+  if (hand_eye.eye_on_hand == false && !T_base_flange.isApprox(Eigen::Isometry3d::Identity())) {
+    throw InputError(params.hand_eye_file +
+                     ": an eye-on-base calibration (T_base_camera) given with a flange pose that "
+                     "is not the identity; for a camera fixed in the cell give an identity "
+                     "--flange-pose (docs/frames.md)");
+  }
+  return T_base_flange * hand_eye.transform;
+}
+
 }  // namespace
 
 void validate(const Params& params) {
@@ -215,11 +229,7 @@ RunResult run_pipeline(const Cloud& input, const Params& params, FeatureBackend&
 
   // Calibration files are read first: a typo there should not cost a full run.
   std::optional<Eigen::Isometry3d> T_base_camera;
-  if (!params.hand_eye_file.empty()) {
-    const Eigen::Isometry3d T_flange_camera = read_transform(params.hand_eye_file);
-    const Eigen::Isometry3d T_base_flange = read_transform(params.flange_pose_file);
-    T_base_camera = T_base_flange * T_flange_camera;
-  }
+  if (!params.hand_eye_file.empty()) T_base_camera = read_T_base_camera(params);
 
   Cloud cloud = input;
   if (params.viewpoint) cloud.viewpoint = *params.viewpoint;
