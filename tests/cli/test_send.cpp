@@ -137,7 +137,12 @@ const char* const kProgram =
 
 class CliSend : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = test::fresh_dir("send"); }
+  // A directory per test: ctest runs these in parallel, and one test's TearDown removed the
+  // shared "send" directory under another's feet.
+  void SetUp() override {
+    dir_ = test::fresh_dir(std::string("send_") +
+                           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path write(const std::string& name, const std::string& bytes) {
     const fs::path p = dir_ / name;

@@ -70,7 +70,11 @@ void expect_pinhole(const Cloud& cloud, const std::vector<std::uint16_t>& d, con
 
 class DepthPng : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = test::fresh_dir("depth_png"); }
+  // A directory per test: ctest runs them in parallel.
+  void SetUp() override {
+    dir_ = test::fresh_dir(std::string("depth_png_") +
+                           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
   void TearDown() override { fs::remove_all(dir_); }
   // scan.png with `depth`, its intrinsics in scan.json unless `sidecar` is empty.
   fs::path scan(const std::vector<std::uint16_t>& depth, const std::string& sidecar) {

@@ -241,8 +241,8 @@ TEST_F(Guards, EachViolationIsNamed) {
   expect_unsafe(t, "waypoint 4: the pose is not finite");
 
   t = straight_path();
-  t.waypoints[5].position.y() = 0.03;  // a 30 mm jump
-  expect_unsafe(t, "waypoint 5: a step of 30.1 mm");
+  t.waypoints[5].position.y() = 0.06;  // a 60 mm jump
+  expect_unsafe(t, "waypoint 5: a step of 60.0 mm");
 
   t = straight_path();
   t.waypoints[2].orientation =
