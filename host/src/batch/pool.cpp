@@ -12,6 +12,7 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <groovetrace/error.hpp>
 #include <groovetrace/features.hpp>
 #include <memory>
@@ -240,6 +241,22 @@ std::string partial_name(const std::string& rel) {
   return host_name() + "-" + std::to_string(::getpid()) + "-" + hex64(fnv1a64(rel));
 }
 
+namespace {
+
+// A process that exists and has not exited. A killed batch's worker is reparented, and until
+// its new parent reaps it, it is a zombie that kill(pid, 0) still finds: its .partial
+// directory stayed, and a resume under load saw a scan twice (CliBatch.KilledBatchResumes).
+bool still_running(pid_t pid) {
+  if (::kill(pid, 0) != 0 && errno == ESRCH) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!stat || !std::getline(stat, text)) return true;  // no /proc: trust kill()
+  const auto close = text.rfind(')');                   // the name in parentheses may hold spaces
+  return close == std::string::npos || close + 2 >= text.size() || text[close + 2] != 'Z';
+}
+
+}  // namespace
+
 void remove_stale_partials(const std::string& out_dir) {
   const fs::path partial = fs::path(out_dir) / ".partial";
   const std::string prefix = host_name() + "-";
@@ -248,7 +265,7 @@ void remove_stale_partials(const std::string& out_dir) {
     const std::string name = entry.path().filename().string();
     if (name.rfind(prefix, 0) != 0) continue;
     const pid_t pid = static_cast<pid_t>(std::atol(name.c_str() + prefix.size()));
-    if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) fs::remove_all(entry.path(), ec);
+    if (pid > 0 && !still_running(pid)) fs::remove_all(entry.path(), ec);
   }
 }
 
