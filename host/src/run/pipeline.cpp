@@ -60,8 +60,12 @@ void run_robust(const Cloud& cloud, const Params& params, FeatureBackend& backen
     ++r.seams_found;
     if (static_cast<int>(r.trajectories.size()) >= rp.max_seams) continue;
     r.trajectories.push_back(seam_trajectory(s, rp));
-    r.passes.push_back(weld_passes(r.trajectories.back(), section_shapes(r.trajectories.back(), s),
-                                   params.weld, params.program, r.warnings));
+    // The fitted sections are only read by multi-pass planning and the weave's bound.
+    const bool sections = params.weld.multi_pass || params.weld.weave != "none";
+    r.passes.push_back(weld_passes(
+        r.trajectories.back(),
+        sections ? section_shapes(r.trajectories.back(), s) : std::vector<SectionShape>{},
+        params.weld, params.program, r.warnings));
   }
   if (r.trajectories.empty()) throw NoGrooveError(no_robust_groove(r.robust));
   timer.lap("trajectory");
