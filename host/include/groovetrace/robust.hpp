@@ -43,6 +43,9 @@ struct GrooveSection {
   bool square_side = false;
   double wall_left_deg = 0, wall_right_deg = 0;  ///< each wall's dip below the top (deg)
   double misalignment = 0;  ///< top on the right (across) side minus the left's (m): high-low
+  /// The root gap measured at this station (m; two-wall V's, else 0). Once the seam's gap is
+  /// applied, `root` is the middle of the opening at the root faces and `depth` is to there.
+  double gap = 0;
   /// A concave corner between two faces (a fillet or lap joint), not a V: the edges are the
   /// weld's leg ends on the faces, `normal` and `bisector` the corner's bisector.
   bool corner = false;

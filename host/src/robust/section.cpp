@@ -195,6 +195,7 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
   sec.wall_left_deg = f.wall_left_deg;
   sec.wall_right_deg = f.wall_right_deg;
   sec.misalignment = f.misalignment;
+  sec.gap = f.gap;
   sec.corner = f.corner;
   sec.short_face = f.short_face;
   return sec;

@@ -76,6 +76,9 @@ struct VProfile {
   bool square_side = false;
   /// The right top side's height minus the left's above the root (m): plates set high-low.
   double misalignment = 0.0;
+  /// Two-wall V's: the root gap's width estimated from the points below the walls (m, 0 when
+  /// none; v_profile.cpp, step 7). `root` stays the walls' intersection.
+  double gap = 0.0;
   /// A concave corner between two faces with no top (fit_corner_profile): a fillet or lap
   /// joint. Edges are the weld's leg ends on the faces, `top` the weld face between them.
   bool corner = false;

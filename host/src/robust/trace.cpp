@@ -264,6 +264,27 @@ void reject_inconsistent(std::vector<GrooveSection>& secs) {
   }
 }
 
+// The root of a joint with a root gap is the middle of the opening at the root faces, not where
+// the walls, extended, meet below it (a 0.5 mm gap puts that 0.43 mm deeper in a 60 deg V, a
+// bevel's 0.5 mm off to its square side as well). One station's gap is a handful of points, so
+// the seam's is the median over its two-wall sections; every section whose root is the walls'
+// meeting point (a one-wall one's is anchored after) moves up the line from it to the
+// opening's centre by the share gap / width, where the walls are the gap apart.
+void open_root_gap(std::vector<GrooveSection>& secs) {
+  std::vector<double> gaps;
+  for (const auto& s : secs) {
+    if (s.ok && !s.one_wall && !s.corner) gaps.push_back(s.gap);
+  }
+  if (gaps.size() < 3) return;
+  const double gap = upper_median(gaps);
+  for (auto& s : secs) {
+    if (!s.ok || s.corner || (s.one_wall && !s.square_side) || !(s.width > gap)) continue;
+    const double t = gap / s.width;
+    s.root += t * (0.5 * (s.edge_left + s.edge_right) - s.root);
+    s.depth *= 1.0 - t;
+  }
+}
+
 // A one-wall section's root (where the unseen wall would meet the seen one) is sensitive to
 // where the unseen rim is guessed; its depth is not. Where the seam has two-wall sections,
 // one-wall roots are put the seam's median depth below their opening's centre, along the
@@ -471,6 +492,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
       mode = seam_fit_mode(raw);
       mode.kind = kind;
     }
+    open_root_gap(raw);
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);

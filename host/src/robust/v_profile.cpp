@@ -708,6 +708,70 @@ VProfile one_wall_v(const VModel& m, const VProfile& two_wall, const ProfileFit&
   return alt;
 }
 
+// Height of the V `m`'s wall at u (m), between its edges: the line from the root to the
+// edge on u's side.
+double wall_height(const VModel& m, double u) {
+  const Eigen::Vector2d e = u < m.root.x() ? m.edge_left() : m.edge_right();
+  const double run = e.x() - m.root.x();
+  if (std::abs(run) < 1e-9) return m.root.y();
+  return m.root.y() + (e.y() - m.root.y()) * (u - m.root.x()) / run;
+}
+
+// 7. The root gap (m). Where the walls end at root faces, the slot between them shows the
+//    table below the walls; a sharp V blurred by stereo matching reads above its walls there,
+//    not below. The rays into the opening (w: across the view) sample the groove; each ray in
+//    the groove's lower half that lands more than `band` (m) below the walls covers half the
+//    way to its neighbours in w, and their sum, taken back to the top by the view's slant, is
+//    the gap. Missed (0): a slot narrower than the blur, which reads shallow, and one seen at a
+//    slant, whose rays meet its side faces just below the root faces. `rest`: the points of
+//    the window not in the slot.
+double root_gap(const VModel& m, const ProfileFit& f, double band, double depth,
+                std::vector<Eigen::Vector2d>& rest) {
+  const Eigen::Vector2d across(f.view.y(), -f.view.x());  // w: across the view
+  const double wl = m.edge_left().dot(across), wr = m.edge_right().dot(across);
+  const double lo = std::min(wl, wr), hi = std::max(wl, wr);
+  std::vector<std::pair<double, bool>> rays;  // w, deep
+  rest.clear();
+  for (const auto& p : f.pts) {
+    const double w = p.dot(across);
+    const double above_root = wall_height(m, p.x()) - m.root.y();
+    const bool low = p.x() > m.u_left && p.x() < m.u_right && above_root < 0.5 * depth;
+    const bool ray = w > lo && w < hi;
+    const bool deep = ray && low && nearest_piece(p, m).second < -band;
+    if (ray) rays.push_back({w, deep});
+    if (!deep) rest.push_back(p);
+  }
+  const double slant = std::abs(f.view.y());
+  if (rays.size() < 2 * kMinWall || slant < 0.2) return 0.0;
+  std::sort(rays.begin(), rays.end());
+  double covered = 0;  // w covered by the deep rays: each takes half the way to its neighbours
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    if (!rays[k].second) continue;
+    const double prev = k > 0 ? rays[k - 1].first : lo;
+    const double next = k + 1 < rays.size() ? rays[k + 1].first : hi;
+    covered += 0.5 * (next - prev);
+  }
+  return covered / slant;
+}
+
+// A V with a root gap: the slot's points drag the walls' fit down towards them (2 mm of
+// table seen 3 mm below the root faces moved the root 0.5 mm), so the V is refitted without
+// them. `m` is the two-wall V `two_wall`, fitted tied by `tie`.
+VProfile with_root_gap(VModel& m, const ProfileFit& f, Tie tie, VProfile two_wall) {
+  // Twice the walls' rms: depths quantized to 1 mm put a wall's points on a staircase.
+  const double band = 2 * std::max(two_wall.rms, f.sigma);
+  std::vector<Eigen::Vector2d> rest;
+  two_wall.gap = root_gap(m, f, band, two_wall.depth, rest);
+  if (!(two_wall.gap > 0)) return two_wall;
+  VModel refit = m;
+  if (!refine_v(rest, refit, f.scale, f.vertex_zone, 0.1 * f.W, tie)) return two_wall;
+  VProfile again = judge_v(refit, false, f);
+  if (!again.ok) return two_wall;
+  again.gap = root_gap(refit, f, band, again.depth, rest);
+  m = refit;
+  return again;
+}
+
 // The V model fitted (steps 1-6), `ok` or why not.
 VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit mode,
                const Eigen::Vector2d& view) {
@@ -758,7 +822,7 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
     if (refine_v(f.pts, tied, f.scale, f.vertex_zone, 0.1 * f.W, tie)) m = tied;
   }
   const VProfile two_wall = judge_v(m, false, f);
-  if (two_wall.ok) return two_wall;
+  if (two_wall.ok) return with_root_gap(m, f, tie, two_wall);
   return one_wall_v(m, two_wall, f, groove, mode);
 }
 

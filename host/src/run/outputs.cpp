@@ -44,6 +44,7 @@ json stations_json(const SeamCandidate& seam) {
          {"included_angle_deg", s.ok ? num(s.opening_deg) : json(nullptr)},
          {"misalignment_m",
           s.ok && !s.one_wall && !s.corner ? num(std::abs(s.misalignment)) : json(nullptr)},
+         {"gap_m", s.ok && !s.one_wall && !s.corner ? num(s.gap) : json(nullptr)},
          {"fit", fit}});
   }
   return out;
