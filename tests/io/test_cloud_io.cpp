@@ -651,13 +651,38 @@ TEST_F(CloudIo, PlyLayoutsPclWritesPastAreRefused) {
                   "a second vertex element");
   expect_rejected(
       file("blank.ply", crafted_ply(120, " obj_info num_cols 120\nobj_info num_rows 1\n")),
-      "line 3 starts with a blank");
+      "line 3 starts with white space");
   const std::string rgba =
       "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n"
       "property float intensity\n";
   EXPECT_EQ(
       read_cloud(file("rgba.ply", ply_with_properties(rgba, "1 2 3 4 0.5")).string()).count_valid(),
       120u);
+}
+
+// Found by fuzz_ply: PCL finds a header line's keyword past any white space but hands an
+// obj_info line as written to its callback, which splits it at blanks and tabs only and asserts
+// that the first word is obj_info (exit 134). A line starting with a carriage return
+// ("\robj_info isrgb_pixelsize ...") passed the blank check; a vertical tab or form feed would
+// have too. A carriage return inside an obj_info line joined its words for PCL only: a 1 x 1
+// grid for 120 vertices went unchecked (the same assertion). Tabs, runs of blanks and CRLF
+// line ends split alike for both and still read as a grid.
+TEST_F(CloudIo, PlyHeaderLinesPclSplitsOtherwiseAreRefused) {
+  for (const char* lead : {"\r", "\v", "\f", "\t", " "}) {
+    SCOPED_TRACE(static_cast<int>(lead[0]));
+    expect_rejected(
+        file("lead.ply", crafted_ply(120, std::string(lead) + "obj_info isrgb_pixelsize 3\n")),
+        "line 3 starts with white space");
+  }
+  expect_rejected(
+      file("cr.ply", crafted_ply(120, "obj_info\rx num_cols 1\nobj_info\rx num_rows 1\n")),
+      "line 3 has a carriage return between its words");
+  for (const char* grid : {"obj_info\tnum_cols 12\nobj_info  num_rows\t 10\n",
+                           "obj_info num_cols 12\r\nobj_info num_rows 10\r\n"}) {
+    const Cloud c = read_cloud(file("grid.ply", crafted_ply(120, grid)).string());
+    EXPECT_EQ(c.width, 12u);
+    EXPECT_EQ(c.height, 10u);
+  }
 }
 
 TEST_F(CloudIo, FailuresPrintNothing) {

@@ -155,6 +155,25 @@ bool parse_ply_line(const std::vector<std::string_view>& tokens, int line_no, bo
   return false;
 }
 
+// PCL finds a header line's keyword past any white space, but hands an obj_info line to its
+// callback as written, which splits it at blanks and tabs only and asserts that the first word
+// is "obj_info": a leading blank made that word empty, and a leading carriage return (which
+// split_ws skips) made it "\robj_info", both an assertion in its reader (exit 134); a vertical
+// tab or form feed would too. A carriage return between words joined them for PCL alone:
+// "obj_info\rx num_cols 1" set a grid that parse_obj_info never saw (1 x 1 for 120 vertices,
+// the same assertion). A CRLF line end splits alike for both and is kept.
+void check_pcl_split(std::string_view line, const std::vector<std::string_view>& tokens,
+                     int line_no) {
+  const char first = line.front();
+  if (first == ' ' || first == '\t' || first == '\r' || first == '\v' || first == '\f') {
+    reject("malformed PLY header: line " + std::to_string(line_no) + " starts with white space");
+  }
+  if (tokens[0] == "obj_info" && line.find('\r') < line.find_last_not_of('\r')) {
+    reject("malformed PLY header: line " + std::to_string(line_no) +
+           " has a carriage return between its words");
+  }
+}
+
 // PCL's PLY reader sizes its buffers from the element counts before reading any data, so
 // the counts are checked against the file size first: each value takes at least its size
 // in binary, and at least a digit and a separator in ASCII (list properties at least their
@@ -174,11 +193,7 @@ void check_ply_structure(const std::string& content) {
       continue;
     }
     if (tokens.empty()) continue;
-    // PCL hands an obj_info line to its callback as written and splits it at blanks itself: a
-    // leading blank made its first word empty, an assertion in its reader (exit 134).
-    if (line.front() == ' ' || line.front() == '\t') {
-      reject("malformed PLY header: line " + std::to_string(line_no) + " starts with a blank");
-    }
+    check_pcl_split(line, tokens, line_no);
     seen_end = parse_ply_line(tokens, line_no, seen_format, body);
   }
   if (!seen_end) reject("malformed PLY header: no end_header line");
