@@ -186,6 +186,7 @@ TEST_F(BadInput, BadFlagValues) {
       {"--backend gpu", "--backend"},
       {"--method magic", "--method"},
       {"--viewpoint 1,2", "--viewpoint"},
+      {"--viewpoint 0,2000,0.1", "out of range [-1000, 1000] m"},
       {"--smooth maybe", "--smooth"},
       {"--no-such-flag 1", "no-such-flag"},
       {"--weld-speed 0", "--weld-speed"},
@@ -228,6 +229,12 @@ TEST_F(BadInput, BadConfigFiles) {
                  "nests brackets deeper than 64");
   expect_failure(scan + " --config " + write("c7.json", "{\"radius\": " + deep).string(), 3,
                  "nests brackets deeper than 64");
+  // fuzz_config_yaml: a viewpoint of 1.1e97 m became inf in its float, not JSON in the report.
+  expect_failure(
+      scan + " --config " +
+          write("c10.yaml", "viewpoint: \"0,1" + std::string(96, '1') + "0,0.1\"\nunits: mm\n")
+              .string(),
+      2, "out of range [-1000, 1000] m");
   // Only regular files: a directory was silently ignored (exit 0), a FIFO hung the run.
   fs::create_directory(dir_ / "c8.yaml");
   expect_failure(scan + " --config " + (dir_ / "c8.yaml").string(), 3, "is a directory");

@@ -2,6 +2,7 @@
 // keys, and round-trips through report.json's text; config files the fuzzer found mishandled.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <groovetrace/config.hpp>
@@ -131,6 +132,40 @@ TEST(ConfigFile, ErrorsQuotingTheFileStayOneLine) {
             std::string::npos);
   EXPECT_NE(config_error<UsageError>("nl.json", "{\"a\\nb\": 1}").find("unknown parameter 'a?b'"),
             std::string::npos);
+}
+
+TEST(ConfigFile, AViewpointBeyondAKilometreIsRefused) {
+  // fuzz_config_yaml: a viewpoint of 1.1e97 m, finite as a double, became inf in the float it
+  // is kept in; validate refused it, but params_json printed it as "inf", which is not JSON.
+  // A viewpoint is bounded as a scan's points are (1000 m, in metres whatever the units).
+  const std::string far = "0,1" + std::string(96, '1') + "0,0.1";
+  const std::string what =
+      config_error<UsageError>("far.yaml", "viewpoint: \"" + far + "\"\nunits: mm\n");
+  EXPECT_NE(what.find("viewpoint: 1111"), std::string::npos) << what;
+  EXPECT_NE(what.find("out of range [-1000, 1000] m"), std::string::npos) << what;
+  // What the file set before the error is what a run would report: still JSON.
+  Params p;
+  EXPECT_THROW(apply_config_file(p, config_file("far2.yaml", "viewpoint: \"" + far + "\"\n")),
+               UsageError);
+  EXPECT_TRUE(nlohmann::json::accept(params_json(p))) << params_json(p);
+  EXPECT_THROW(set_param(p, "viewpoint", "0,-1000.5,0"), UsageError);
+  set_param(p, "viewpoint", "-1000,0,1000");
+  EXPECT_NO_THROW(validate(p));
+}
+
+// Set from code, a non-finite value is null in the parameters' JSON (as in report.json's other
+// numbers), and validate still refuses it.
+TEST(Params, NonFiniteValuesAreNullAndRefused) {
+  Params p;
+  p.viewpoint = Eigen::Vector3f(INFINITY, 0, 0);
+  p.paper.radius = NAN;
+  const auto j = nlohmann::json::parse(params_json(p));
+  EXPECT_TRUE(j["viewpoint"][0].is_null()) << j["viewpoint"];
+  EXPECT_TRUE(j["radius"].is_null()) << j["radius"];
+  EXPECT_THROW(validate(p), UsageError);
+  Params q;
+  q.paper.radius = INFINITY;
+  EXPECT_THROW(validate(q), UsageError);
 }
 
 TEST(ConfigFile, PathsAreTheConfigFilesFolders) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <groovetrace/cloud.hpp>
 #include <groovetrace/config.hpp>
 #include <groovetrace/error.hpp>
 #include <limits>
@@ -72,7 +73,10 @@ std::string one_of(const std::string& key, const std::string& text,
   throw UsageError(key + ": expected one of " + list + ", got '" + text + "'");
 }
 
+// A non-finite number is null, as in report.json's other numbers: "inf" is not JSON. validate
+// refuses a null where a number belongs.
 std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
@@ -173,11 +177,17 @@ ParamSpec path(const std::string& key, const std::string& help, std::string Para
           true};
 }
 
+// The viewpoint is in metres whatever --units says, and bounded as a scan's points are: a
+// coordinate beyond kMaxCoordinate is a wrong unit or a typo. Unbounded, a finite double such
+// as 1.1e97 became inf in the float it is kept in, which validate refused and params_json
+// printed as "inf" (fuzz_config_yaml).
 Eigen::Vector3f parse_viewpoint(const std::string& t) {
   std::stringstream ss(t);
   std::string part;
   std::vector<double> v;
-  while (std::getline(ss, part, ',')) v.push_back(parse_number("viewpoint", part));
+  while (std::getline(ss, part, ',')) {
+    v.push_back(in_range("viewpoint", part, -kMaxCoordinate, kMaxCoordinate, " m"));
+  }
   if (v.size() != 3) {
     throw UsageError("viewpoint: expected X,Y,Z (three numbers), got '" + t + "'");
   }

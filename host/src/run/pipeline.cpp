@@ -204,7 +204,9 @@ void validate(const Params& params) {
   Params scratch = params;
   for (const auto& spec : param_specs()) {
     std::string text = spec.json(params);
-    if (text == "null") continue;
+    // Only an optional parameter is unset as null; a number's null is a non-finite value set
+    // from code, which its spec refuses.
+    if (text == "null" && spec.unset) continue;
     if (text.size() >= 2 && text.front() == '"')
       text = nlohmann::json::parse(text).get<std::string>();
     if (text.size() >= 2 && text.front() == '[') text = text.substr(1, text.size() - 2);
