@@ -108,10 +108,12 @@ std::vector<Eigen::Vector2d> gapped_v_profile(double gap, double noise, unsigned
 TEST(RobustSection, RootGapIsMeasuredFromTheSlot) {
   // Seen straight down, a 2 mm slot is 20 samples of the table: measured within 0.6 mm (the
   // noise puts 2-3 % of the walls' samples below the 2-sigma band, a few tenths of a mm), and
-  // the table's points do not pull the walls (the root stays where they meet; the seam lifts
-  // it to the root faces, trace.cpp). A sharp V reads no gap.
+  // on a seam known to have a gap the table's points do not pull the walls (the root stays
+  // where they meet; the seam lifts it to the root faces, trace.cpp). A sharp V reads none.
+  VFit seam_with_gap;
+  seam_with_gap.root_gap = true;
   for (unsigned seed = 1; seed <= 3; ++seed) {
-    const VProfile g = fit_v_profile(gapped_v_profile(0.002, 0.0002, seed), 0.02);
+    const VProfile g = fit_v_profile(gapped_v_profile(0.002, 0.0002, seed), 0.02, seam_with_gap);
     ASSERT_TRUE(g.ok) << g.why;
     EXPECT_NEAR(g.gap, 0.002, 0.0006) << seed;
     const double walls_meet = -0.008 - 0.001 / std::tan(M_PI / 6);

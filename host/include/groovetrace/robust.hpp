@@ -93,6 +93,7 @@ struct SeamCandidate {
   };
   std::vector<Tack> tacks;
   double misalignment = 0.0;  ///< |median high-low| of the tops over the ok sections (m)
+  double gap = 0.0;           ///< root gap: median over the two-wall sections (m; 0 where not seen)
   double scale = 0.0;         ///< the search scale it was found at (m; RobustParams::scales)
   bool accepted = false;
   std::string reason;   ///< why rejected (empty when accepted)

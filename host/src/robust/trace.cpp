@@ -264,25 +264,32 @@ void reject_inconsistent(std::vector<GrooveSection>& secs) {
   }
 }
 
+// The seam's root gap (m): the median over its two-wall sections; 0 with fewer than three.
+double seam_gap(const std::vector<GrooveSection>& secs) {
+  std::vector<double> gaps;
+  for (const auto& s : secs) {
+    if (s.ok && !s.one_wall && !s.corner) gaps.push_back(s.gap);
+  }
+  return gaps.size() < 3 ? 0.0 : upper_median(gaps);
+}
+
 // The root of a joint with a root gap is the middle of the opening at the root faces, not where
 // the walls, extended, meet below it (a 0.5 mm gap puts that 0.43 mm deeper in a 60 deg V, a
 // bevel's 0.5 mm off to its square side as well). One station's gap is a handful of points, so
 // the seam's is the median over its two-wall sections; every section whose root is the walls'
 // meeting point (a one-wall one's is anchored after) moves up the line from it to the
-// opening's centre by the share gap / width, where the walls are the gap apart.
-void open_root_gap(std::vector<GrooveSection>& secs) {
-  std::vector<double> gaps;
-  for (const auto& s : secs) {
-    if (s.ok && !s.one_wall && !s.corner) gaps.push_back(s.gap);
-  }
-  if (gaps.size() < 3) return;
-  const double gap = upper_median(gaps);
+// opening's centre by the share gap / width, where the walls are the gap apart. Returns the
+// seam's gap (m; 0 with fewer than three two-wall sections).
+double open_root_gap(std::vector<GrooveSection>& secs) {
+  const double gap = seam_gap(secs);
+  if (!(gap > 0)) return 0.0;
   for (auto& s : secs) {
     if (!s.ok || s.corner || (s.one_wall && !s.square_side) || !(s.width > gap)) continue;
     const double t = gap / s.width;
     s.root += t * (0.5 * (s.edge_left + s.edge_right) - s.root);
     s.depth *= 1.0 - t;
   }
+  return gap;
 }
 
 // A one-wall section's root (where the unseen wall would meet the seen one) is sensitive to
@@ -352,6 +359,7 @@ bool stepped_seam(const std::vector<GrooveSection>& secs) {
 
 VFit seam_fit_mode(const std::vector<GrooveSection>& secs) {
   VFit mode;
+  mode.root_gap = seam_gap(secs) > 0;
   mode.stepped = stepped_seam(secs);
   mode.symmetric = !mode.stepped && symmetric_seam(secs);
   mode.square = mode.stepped || mode.symmetric ? 0 : bevel_square_side(secs);
@@ -492,7 +500,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
       mode = seam_fit_mode(raw);
       mode.kind = kind;
     }
-    open_root_gap(raw);
+    seam.gap = open_root_gap(raw);
     anchor_one_wall_roots(raw);
     align_bisectors(raw);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);

@@ -754,15 +754,17 @@ double root_gap(const VModel& m, const ProfileFit& f, double band, double depth,
   return covered / slant;
 }
 
-// A V with a root gap: the slot's points drag the walls' fit down towards them (2 mm of
-// table seen 3 mm below the root faces moved the root 0.5 mm), so the V is refitted without
-// them. `m` is the two-wall V `two_wall`, fitted tied by `tie`.
-VProfile with_root_gap(VModel& m, const ProfileFit& f, Tie tie, VProfile two_wall) {
+// The two-wall V `two_wall` (model `m`, fitted tied by `tie`) with its root gap measured. On
+// a seam with a gap (`refit_seam`), the slot's points drag the walls' fit down towards them (2 mm
+// of table seen 3 mm below the root faces moved the root 0.5 mm), so the V is refitted
+// without them.
+VProfile with_root_gap(VModel& m, const ProfileFit& f, Tie tie, VProfile two_wall,
+                       bool refit_seam) {
   // Twice the walls' rms: depths quantized to 1 mm put a wall's points on a staircase.
   const double band = 2 * std::max(two_wall.rms, f.sigma);
   std::vector<Eigen::Vector2d> rest;
   two_wall.gap = root_gap(m, f, band, two_wall.depth, rest);
-  if (!(two_wall.gap > 0)) return two_wall;
+  if (!refit_seam || !(two_wall.gap > 0)) return two_wall;
   VModel refit = m;
   if (!refine_v(rest, refit, f.scale, f.vertex_zone, 0.1 * f.W, tie)) return two_wall;
   VProfile again = judge_v(refit, false, f);
@@ -822,7 +824,7 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
     if (refine_v(f.pts, tied, f.scale, f.vertex_zone, 0.1 * f.W, tie)) m = tied;
   }
   const VProfile two_wall = judge_v(m, false, f);
-  if (two_wall.ok) return with_root_gap(m, f, tie, two_wall);
+  if (two_wall.ok) return with_root_gap(m, f, tie, two_wall, mode.root_gap);
   return one_wall_v(m, two_wall, f, groove, mode);
 }
 

@@ -85,6 +85,7 @@ json seam_json(const SeamCandidate& s, std::size_t rank, const json& file, const
             {"opening_deg", num(s.opening_deg)},
             {"joint", s.joint},
             {"misalignment_m", num(s.misalignment)},
+            {"gap_m", s.corner ? json(nullptr) : num(s.gap)},
             {"scale_m", num(s.scale)},
             {"tacks", tacks_json(s)},
             {"file", file}};
