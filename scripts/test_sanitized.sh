@@ -14,4 +14,21 @@ cmake --build build-asan -j"$(nproc)"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:use_sigaltstack=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
-ctest --test-dir build-asan --output-on-failure -j"$(nproc)" --timeout 1800 "$@"
+log=build-asan/sanitized-ctest.log
+set +e
+ctest --test-dir build-asan --output-on-failure -j"$(nproc)" --timeout 1800 "$@" 2>&1 | tee "$log"
+rc=${PIPESTATUS[0]}
+set -e
+[ "$rc" -eq 0 ] && exit 0
+# LeakSanitizer's own stop-the-world tracer now and then crashes as a process exits, after
+# the test passed ("Tracer caught signal 11 ... LeakSanitizer has encountered a fatal error",
+# google/sanitizers#1353; seen once in 400 tests on a loaded machine). That is not a finding:
+# only when every failure is one of those are the failed tests run once more.
+failed=$(grep -c ' Test  *#[0-9]*: .*\*\*\*' "$log" || true)  # Failed, Timeout, Exception
+tracer=$(grep -c '^Tracer caught signal' "$log" || true)
+if [ "$failed" -gt 0 ] && [ "$tracer" -ge "$failed" ]; then
+  echo "test_sanitized: $failed failure(s), all LeakSanitizer tracer crashes: running them again"
+  ctest --test-dir build-asan --output-on-failure --timeout 1800 --rerun-failed
+else
+  exit 1
+fi

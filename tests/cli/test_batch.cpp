@@ -161,11 +161,13 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
 
 TEST_F(CliBatch, HangingScanTimesOut) {
   write_scan(in_ / "line1" / "a.pcd", 1);
-  // hang.pcd waits forever: killed after 30 s. The timeout leaves room for a.pcd, whose clock
-  // includes the worker's start: 10 s were too few in the sanitizer build on a loaded machine.
+  // hang.pcd waits forever: killed after 30 s (150 s sanitized). The timeout leaves room for
+  // a.pcd, whose clock includes the worker's start: 30 s were too few in the sanitizer build
+  // on a loaded machine.
   write_scan(in_ / "line1" / "hang.pcd", 2);
-  const auto r = test::run_cli(batch("--jobs 1 --scan-timeout 30 --progress none"), dir_,
-                               "GROOVETRACE_TEST_HANG_SCAN=hang.pcd");
+  const std::string timeout = std::to_string(30 * test::kSlowdown);
+  const auto r = test::run_cli(batch("--jobs 1 --scan-timeout " + timeout + " --progress none"),
+                               dir_, "GROOVETRACE_TEST_HANG_SCAN=hang.pcd");
   EXPECT_EQ(r.exit_code, 6) << r.err;
   EXPECT_EQ(r.err, "");
   const std::map<std::string, std::string> expected = {{"line1/a", "ok"},
@@ -186,7 +188,8 @@ TEST_F(CliBatch, KilledBatchResumes) {
             "--jobs", "1", "--progress", "none", static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(120 * test::kSlowdown);
   while (fs::exists(dir_ / "out") ? count_files(dir_ / "out", "scan.json") < 2 : true) {
     ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the batch made no progress";
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -224,7 +224,8 @@ TEST_F(OutputSet, KillsAtRandomMomentsLeaveOneWholeSet) {
     if (k % 4 < 2) {
       std::this_thread::sleep_for(std::uniform_real_distribution<double>(0, 1)(rng) * full);
     } else {
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+      const auto deadline =
+          std::chrono::steady_clock::now() + std::chrono::seconds(60 * test::kSlowdown);
       while (!temporaries_beside(out_) && std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::microseconds(200));
       }

@@ -7,10 +7,12 @@
 #   - every job completes with exit code 0; summary.csv has the same rows as the single
 #     batch's (timing columns aside) and every trajectory.csv is byte-identical.
 # The daemons are stopped by their PIDs on any exit. GT_KEEP_WORK=1 keeps the work dir.
-# Usage: slurm_cluster_test.sh BUILD_DIR SOURCE_DIR
+# Usage: slurm_cluster_test.sh BUILD_DIR SOURCE_DIR [SLOWDOWN]
+# SLOWDOWN (default 1) multiplies the wait for the jobs: 5 in a sanitized build.
 set -euo pipefail
 build=$(cd "$1" && pwd)
 src=$(cd "$2" && pwd)
+jobs_wait=$((180 * ${3:-1}))
 gt=$build/groovetrace
 for tool in munged munge slurmctld slurmd sbatch squeue sinfo scontrol scancel; do
   command -v "$tool" >/dev/null || { echo "slurm test: $tool not installed (scripts/setup.sh)" >&2; exit 1; }
@@ -143,8 +145,8 @@ ids=$(cd "$work/jobs" && "$src/scripts/slurm/submit.sh" "$work/scans" "$work/nig
 read -r array report <<<"$ids"
 [[ "$array" =~ ^[0-9]+$ && "$report" =~ ^[0-9]+$ ]] || fail "two job ids from submit.sh, saw '$ids'"
 queue_empty() { squeue >/dev/null 2>&1 && [ -z "$(squeue -h -o %i)" ]; }
-wait_for 180 queue_empty ||
-  fail "jobs $array (array) and $report (report) gone within 180 s, left: $(squeue -h -o '%i %T %r' 2>&1 | paste -sd' ')"
+wait_for "$jobs_wait" queue_empty ||
+  fail "jobs $array (array) and $report (report) gone within $jobs_wait s, left: $(squeue -h -o '%i %T %r' 2>&1 | paste -sd' ')"
 
 # Every job (3 array tasks and the report) completed with exit code 0.
 states=$(for j in "$array" "$report"; do scontrol -o show job "$j"; done 2>&1 |

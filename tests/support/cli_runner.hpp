@@ -13,6 +13,10 @@
 
 namespace groovetrace::test {
 
+/// What the tests' time limits (a scan timeout, a deadline for progress) are multiplied by:
+/// 5 in a sanitized build (GT_SANITIZE), whose code runs several times slower, else 1.
+constexpr int kSlowdown = GT_TEST_SLOWDOWN;
+
 struct CliResult {
   int exit_code = -1;
   std::string out, err;

@@ -5,10 +5,16 @@
 #   - every installed header compiles on its own against the package;
 #   - the shared library exports the API and none of the internal stages;
 #   - examples/consumer builds against the package only and finds the groove with both methods.
-# Usage: install_consumer.sh BUILD_DIR SOURCE_DIR
+# Usage: install_consumer.sh BUILD_DIR SOURCE_DIR [SANITIZERS]
+# SANITIZERS (GT_SANITIZE, e.g. address,undefined): the library was built with them, and a
+# program linking it must be too (an uninstrumented program loads ASan's runtime too late).
 set -euo pipefail
 build=$1
 src=$2
+san_flags=()
+if [ -n "${3:-}" ]; then
+  san_flags=(-DCMAKE_CXX_FLAGS="-fsanitize=$3" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=$3")
+fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
@@ -60,6 +66,6 @@ done
 echo "install: $(grep -c 'groovetrace::' <<<"$symbols") groovetrace symbols exported"
 
 cmake -S "$src/examples/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
-  -DCMAKE_BUILD_TYPE=Release >/dev/null
+  -DCMAKE_BUILD_TYPE=Release "${san_flags[@]}" >/dev/null
 cmake --build "$work/build" >/dev/null
 LD_LIBRARY_PATH="$work/prefix/lib:$work/prefix/lib64:${LD_LIBRARY_PATH:-}" "$work/build/consumer"

@@ -76,12 +76,13 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> voxel_keys(const Cloud& clo
     cells.push_back(c);
     index.push_back(static_cast<std::uint32_t>(i));
   }
+  if (cells.empty()) return {};  // lo and hi are still INT64_MAX and INT64_MIN
   // Valid coordinates are finite floats, so each extent is below 2^21 voxels of 1 mm unless
   // the cloud spans kilometres; a key then still fits when the product does.
   const double nx = static_cast<double>(hi[0] - lo[0] + 1),
                ny = static_cast<double>(hi[1] - lo[1] + 1);
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(cells.size());
-  const bool dense = cells.empty() || nx * ny * static_cast<double>(hi[2] - lo[2] + 1) < 1.8e19;
+  const bool dense = nx * ny * static_cast<double>(hi[2] - lo[2] + 1) < 1.8e19;
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const auto& c = cells[k];
     std::uint64_t key;
