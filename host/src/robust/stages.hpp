@@ -101,7 +101,7 @@ struct VFit {
   /// height (their step held at what lines fitted to each side alone give), so the step does
   /// not tilt the top normal or move the edges. Not with `symmetric`.
   bool stepped = false;
-  /// The seam has a root gap (the first pass's median, m; 0: none seen): where a station's
+  /// The seam has a root gap (its first pass's median gap is above 0): where a station's
   /// slot shows, the V is refitted without the slot's points (v_profile.cpp, step 7). Only
   /// then: on a seam without a gap, a station's few stray deep points are noise.
   bool root_gap = false;
