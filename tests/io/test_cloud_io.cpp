@@ -574,6 +574,15 @@ TEST_F(CloudIo, CoordinatesBeyondAKilometre) {
   mm.units_scale = 0.001;
   EXPECT_EQ(read_cloud(mm_file.string(), mm).count_valid(), 120u);  // 900 m
   expect_rejected(mm_file, "has 1 point beyond 1000 m");            // 900 km
+  // The sensor's origin too: at 1e30 m every normal turned towards it and the run gave exit 0.
+  for (const char* far : {"1e30 0 0", "0 -1e300 0", "0 0 1000.5"}) {
+    expect_rejected(file("far_view.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(120),
+                                                   std::string(far) + " 1 0 0 0")),
+                    "has its VIEWPOINT beyond 1000 m");
+  }
+  const fs::path km_view =
+      file("km_view.pcd", ascii_pcd("x y z", 120, 1, 120, xyz_lines(120), "0 0 -1000 1 0 0 0"));
+  EXPECT_EQ(read_cloud(km_view.string()).viewpoint.z(), -1000.0f);
 }
 
 // An ASCII PLY of `n` vertices with `extra` header lines before the vertex element and

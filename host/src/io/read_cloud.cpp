@@ -44,7 +44,15 @@ Cloud to_cloud(const Decoded& decoded, double scale, std::size_t min_valid) {
   const bool organized = blob.height > 1 && blob.width > 1;
   cloud.width = organized ? blob.width : static_cast<std::uint32_t>(n);
   cloud.height = organized ? blob.height : 1;
-  cloud.viewpoint = (decoded.origin.head<3>().cast<double>() * scale).cast<float>();
+  // The sensor's origin is bounded as the points are: a huge one (1e30 m, or 1e300 m, which
+  // is inf as a float) turned every normal towards +-x and gave a garbage result, exit 0.
+  const Eigen::Vector3d viewpoint = decoded.origin.head<3>().cast<double>() * scale;
+  if ((viewpoint.array().abs() > kMaxCoordinate).any()) {
+    reject(
+        "has its VIEWPOINT beyond 1000 m of the frame's origin (a corrupt scan, or a wrong "
+        "--units)");
+  }
+  cloud.viewpoint = viewpoint.cast<float>();
 
   std::vector<float>* out[3] = {&cloud.x, &cloud.y, &cloud.z};
   std::size_t infinite = 0, beyond = 0;
