@@ -14,6 +14,9 @@ cmake --build build-asan -j"$(nproc)"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:use_sigaltstack=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
+# A sanitized scan runs about ten times slower: the tests that run whole scans again and again
+# run fewer or smaller ones (tests/support/scenes.hpp, small_runs), with the same assertions.
+export GT_TEST_SMALL=1
 log=build-asan/sanitized-ctest.log
 set +e
 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" --timeout 1800 "$@" 2>&1 | tee "$log"

@@ -67,9 +67,9 @@ class CliBatch : public ::testing::Test {
     fs::create_directories(in_ / "line1");
     fs::create_directories(in_ / "line2");
   }
-  // A rendered V-groove scan (640x480 at 0.4 m), seeded so that each file differs.
+  // A rendered V-groove scan (test::repeated_run_scene), seeded so that each file differs.
   void write_scan(const fs::path& path, unsigned seed, double depth = 0.004) {
-    test::VGrooveScene s;
+    test::VGrooveScene s = test::repeated_run_scene();
     s.tilt_deg = 5.0 + seed;
     s.noise_sigma = 0.0002;
     s.seed = seed;
@@ -83,12 +83,14 @@ class CliBatch : public ::testing::Test {
 };
 
 // The night in small: 20 synthetic scans (17 from the renderer, 3 rendered here) and
-// four bad ones.
+// four bad ones; with test::small_runs() 5 from the renderer (one per shape).
 TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   std::map<std::string, std::string> expected;
   const char* shapes[] = {"straight", "curve", "lshape", "box", "cylinder"};
+  const int n_synth = test::small_runs() ? 5 : 17;
+  const int n_scans = n_synth + 7;
   fs::create_directories(in_ / "synth");
-  for (int k = 0; k < 17; ++k) {
+  for (int k = 0; k < n_synth; ++k) {
     const std::string name = std::string(shapes[k % 5]) + "-" + std::to_string(k);
     const auto synth = test::run_cli("synth --shape " + std::string(shapes[k % 5]) + " --seed " +
                                          std::to_string(k + 1) + " --resolution 640x480 -o " +
@@ -115,10 +117,10 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
                    {"line2/crash", "crashed"},
                    {"line2/truncated", "invalid_input"},
                    {"line2/empty", "invalid_input"}});
-  ASSERT_EQ(expected.size(), 24u);
+  ASSERT_EQ(expected.size(), static_cast<std::size_t>(n_scans));
   EXPECT_EQ(statuses(dir_ / "out" / "summary.csv"), expected);
   // One progress line per scan, and the scans after the crash still ran.
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 24) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), n_scans) << r.err;
   // No calibration files: the trajectory is in camera coordinates, so no program (docs/robot.md).
   EXPECT_FALSE(fs::exists(dir_ / "out" / "line2" / "a" / "program.script"));
   for (const char* f : {"trajectory.csv", "report.json", "scan.json"}) {
@@ -128,8 +130,8 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   EXPECT_EQ(count_files(dir_ / "out", ".tmp"), 0u);
   EXPECT_FALSE(fs::exists(dir_ / "out" / ".partial"));
   const auto summary = nlohmann::json::parse(test::read_text(dir_ / "out" / "summary.json"));
-  EXPECT_EQ(summary["scans"], 24);
-  EXPECT_EQ(summary["ok"], 20);
+  EXPECT_EQ(summary["scans"], n_scans);
+  EXPECT_EQ(summary["ok"], n_synth + 3);
   const std::string html = test::read_text(dir_ / "out" / "index.html");
   for (const auto& [d, status] : expected) {
     EXPECT_NE(html.find("data-dir=\"" + d + "\""), std::string::npos) << d;
@@ -143,7 +145,7 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
   for (const auto& [d, status] : expected) {
     EXPECT_NE(dom.find("data-dir=\"" + d + "\""), std::string::npos) << d;
   }
-  EXPECT_NE(dom.find("24 scans"), std::string::npos);
+  EXPECT_NE(dom.find(std::to_string(n_scans) + " scans"), std::string::npos);
   EXPECT_NE(dom.find("line1/a/thumbnail.png"), std::string::npos);  // the ok scans have pictures
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;        // script errors
   // Every picture the page shows is there (a broken image is no console error).

@@ -19,7 +19,7 @@ class ProgramSafety : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-    test::VGrooveScene s;  // 640x480 at 0.4 m, 10 mm wide, 4 mm deep
+    test::VGrooveScene s = test::repeated_run_scene();  // 10 mm wide, 4 mm deep
     s.tilt_deg = 10;
     s.noise_sigma = 0.0002;
     scan_ = dir_ / "scan.pcd";
@@ -83,8 +83,8 @@ TEST_F(ProgramSafety, AGuardThatTripsLeavesNoProgram) {
 }
 
 TEST_F(ProgramSafety, WorkspaceBoxInTheBaseFrame) {
-  // The plate lies about 0.4 m in front of the camera (= base): a box ending at 0.3 m refuses.
-  auto r = run(calibration() + " --workspace=-1,-1,-1,1,1,0.3");
+  // The plate lies 0.2 or 0.4 m in front of the camera (= base): a box ending at 0.15 m refuses.
+  auto r = run(calibration() + " --workspace=-1,-1,-1,1,1,0.15");
   EXPECT_EQ(r.exit_code, 7) << r.err;
   EXPECT_NE(r.err.find("lies outside the workspace"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out() / "program.script"));

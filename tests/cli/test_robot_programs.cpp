@@ -18,7 +18,7 @@ class CliRobot : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::fresh_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-    test::VGrooveScene s;  // 640x480 at 0.4 m, 10 mm wide, 4 mm deep groove
+    test::VGrooveScene s = test::repeated_run_scene();  // 10 mm wide, 4 mm deep groove
     s.tilt_deg = 10;
     scan_ = dir_ / "scan.pcd";
     write_file_atomic(scan_.string(), pcd_bytes(test::render_vgroove(s).cloud));

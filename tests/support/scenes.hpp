@@ -4,8 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdlib>
 #include <groovetrace/cloud.hpp>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace groovetrace::test {
@@ -102,6 +104,27 @@ inline RenderedScene render_vgroove(const VGrooveScene& s) {
     }
   }
   return out;
+}
+
+/// Whether the tests that run whole scans again and again run fewer or smaller ones:
+/// GT_TEST_SMALL=1 in the environment. scripts/test_sanitized.sh sets it, as a sanitized
+/// build runs a scan about ten times slower; the assertions stay the same.
+inline bool small_runs() {
+  const char* v = std::getenv("GT_TEST_SMALL");
+  return v != nullptr && std::string(v) == "1";
+}
+
+/// The scan of the CLI tests that run whole scans over and over (kills, concurrent runs,
+/// batches, robot programs): 640x480 at 0.4 m; with small_runs() 320x240 at 0.2 m, the
+/// same 0.8 mm pixel pitch on a quarter of the plate.
+inline VGrooveScene repeated_run_scene() {
+  VGrooveScene s;
+  if (small_runs()) {
+    s.width = 320;
+    s.height = 240;
+    s.distance = 0.2;
+  }
+  return s;
 }
 
 }  // namespace groovetrace::test
