@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite built with AddressSanitizer and UndefinedBehaviorSanitizer in
-# ./build-asan (not in CI yet: README). Every finding stops its process
+# ./build-asan; scripts/test.sh runs it after the Release suite. Every finding stops its process
 # (-fno-sanitize-recover), so the test that trips one fails. Extra arguments go to ctest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
