@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <groovetrace/cloud_io.hpp>
 #include <nlohmann/json.hpp>
@@ -163,11 +164,12 @@ TEST_F(CliBatch, BadScansAreRowsAndTheBatchGoesOn) {
 
 TEST_F(CliBatch, HangingScanTimesOut) {
   write_scan(in_ / "line1" / "a.pcd", 1);
-  // hang.pcd waits forever: killed after 30 s (150 s sanitized). The timeout leaves room for
-  // a.pcd, whose clock includes the worker's start: 30 s were too few in the sanitizer build
-  // on a loaded machine.
+  // hang.pcd waits forever: killed after 30 s (60 s sanitized, on the small scans; 150 s on
+  // full-size ones). The timeout leaves room for a.pcd, whose clock includes the worker's
+  // start: 30 s were too few in the sanitizer build on a loaded machine.
   write_scan(in_ / "line1" / "hang.pcd", 2);
-  const std::string timeout = std::to_string(30 * test::kSlowdown);
+  const int slowdown = test::small_runs() ? std::min(test::kSlowdown, 2) : test::kSlowdown;
+  const std::string timeout = std::to_string(30 * slowdown);
   const auto r = test::run_cli(batch("--jobs 1 --scan-timeout " + timeout + " --progress none"),
                                dir_, "GROOVETRACE_TEST_HANG_SCAN=hang.pcd");
   EXPECT_EQ(r.exit_code, 6) << r.err;
