@@ -52,7 +52,9 @@ struct RobustParams {
   double threshold_k = 4.0;  ///< candidate: concavity > median + k * robust sigma
   double station = 0.0015;   ///< spacing of the fitted cross-sections along a seam (m)
   double slab = 0.0015;      ///< half-thickness of a cross-section along the seam (m)
-  double smooth = 0.006;     ///< half-window of the smoothing along the seam (m)
+  /// Half-window of the smoothing along the seam (m): the seam's curve and roots over it, the
+  /// groove's shape over 5 times it. At scales beyond 20 mm, 0.3 times the scale.
+  double smooth = 0.006;
   /// Half-window of the torch path's smoothing in depth, along the top normal (m;
   /// docs/method-robust.md, "Trajectory").
   double depth_smooth = 0.024;

@@ -96,14 +96,20 @@ std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes&
 
 // The widest groove a scale's window holds with top surface on both sides, per metre of scale.
 constexpr double kWidthPerScale = 1.6;
+// The root's smoothing half-window along the seam per metre of scale (see at_scale).
+constexpr double kSmoothPerScale = 0.3;
 
 // The parameters of the search at `scale` (m): the crease radius and the section window
 // follow it, and so do the voxels (a tenth of it, never finer than `cell`), so that a ball
-// holds about as many voxels at every scale.
+// holds about as many voxels at every scale. So does the smoothing along the seam beyond
+// 20 mm (0.3 scale, never below `smooth`): a joint 60-100 mm wide bends slowly, but
+// the root of its 10-15 deg walls moves across by several times the depth noise, and over
+// +-6 mm its path wandered by 1-2 mm (docs/method-robust.md, "Smoothing along the seam").
 RobustParams at_scale(const RobustParams& params, double scale) {
   RobustParams p = params;
   p.scale = scale;
   p.cell = std::max(params.cell, 0.1 * scale);
+  p.smooth = std::max(params.smooth, kSmoothPerScale * scale);
   return p;
 }
 

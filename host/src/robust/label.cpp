@@ -17,11 +17,14 @@
 namespace groovetrace {
 namespace {
 
+constexpr double kMaxFan = 3 * M_PI / 180;  // rad: see opening_of
+
 struct Opening {
   Eigen::Vector3d centre, across, along, out;  // out: opening plane normal, towards the sensor
   double half_width, tolerance, reach;         // m
-  bool disc;                                   // at a corner: a disc of half_width, not a slice
-  int end;  // +1 / -1: the seam's open end lies along +along / -along; 0: inside
+  double end_reach;  // m: how far past an open end's centre a point itself may lie
+  bool disc;         // at a corner: a disc of half_width, not a slice
+  int end;           // +1 / -1: the seam's open end lies along +along / -along; 0: inside
 };
 
 // The larger spacing (m) from section k to its neighbours along the seam (wrapping on rings).
@@ -36,6 +39,22 @@ double station_spacing(const SeamCandidate& seam, std::size_t k) {
     if (k + 1 == n) next = (secs[0].root - root).norm();
   }
   return std::max(prev, next);
+}
+
+// The largest angle (rad) between section k's chord `across` (unit) and its neighbours'
+// (wrapping on rings).
+double fan_angle(const SeamCandidate& seam, std::size_t k, const Eigen::Vector3d& across) {
+  const auto& secs = seam.sections;
+  const std::size_t n = secs.size();
+  double fan = 0;
+  const auto turn = [&](std::size_t j) {
+    const Eigen::Vector3d chord = secs[j].edge_right - secs[j].edge_left;
+    if (!(chord.norm() > 0)) return;
+    fan = std::max(fan, std::acos(std::clamp(chord.normalized().dot(across), -1.0, 1.0)));
+  };
+  if (k > 0 || seam.closed) turn((k + n - 1) % n);
+  if (k + 1 < n || seam.closed) turn((k + 1) % n);
+  return fan;
 }
 
 // The opening of section k of `seam`; false when its edges coincide.
@@ -53,8 +72,15 @@ bool opening_of(const SeamCandidate& seam, std::size_t k, Opening& o) {
   // Half the spacing to the neighbours, with overlap so that the fan of sections around a
   // bend leaves no gaps; the open ends reach one spacing further (the seam runs to the
   // part's edge).
+  // Neighbouring chords that turn by an angle leave a wedge between their slices that
+  // grows across the opening: a 100 mm wide joint's rims, read to a millimetre, turn its
+  // chords by a degree or two, and 1 deg opens a 0.9 mm gap 50 mm out, wider than the slice.
+  // Each slice reaches over its half of that wedge. Chords turned by more than kMaxFan
+  // are an outlier's (a fit that caught a rim or a shadow), not a wedge to fill.
   const double spacing = station_spacing(seam, k);
-  o.reach = 0.6 * spacing;
+  o.end_reach = 0.6 * spacing;
+  const double fan = fan_angle(seam, k, o.across);
+  o.reach = o.end_reach + (fan <= kMaxFan ? 0.5 * o.half_width * std::sin(fan) : 0.0);
   o.end = 0;
   if (!seam.closed && n > 1 && (k == 0 || k + 1 == n)) {
     // Does `along` point out of the seam here?
@@ -101,7 +127,7 @@ bool behind(const Opening& o, const Eigen::Vector3d& p, const Eigen::Vector3d& r
   if (std::abs(r.dot(o.along)) > o.reach) return false;
   // Past an open end (a plate's edge) the ray may pass the opening's plane and meet the
   // table beyond the part: the point itself must lie within the seam's end too.
-  if (o.end != 0 && o.end * (p - o.centre).dot(o.along) > o.reach) return false;
+  if (o.end != 0 && o.end * (p - o.centre).dot(o.along) > o.end_reach) return false;
   return std::abs(r.dot(o.across)) <= o.half_width;
 }
 
