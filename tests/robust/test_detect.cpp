@@ -365,9 +365,10 @@ TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {
   EXPECT_NEAR(s.opening_deg, 150, 5);
   EXPECT_LT(run.errors(s).first, 0.0015);
   // Its region is whole: the sections' 100 mm chords turned by a degree or two between
-  // stations and left wedges between their 1.5 mm slices. IoU 0.73; 0.88 with the root
-  // smoothed over +-12 mm at this scale (robust/detect.cpp, at_scale); 0.925 with each slice
-  // also reaching over its half of the wedge (robust/label.cpp).
+  // stations and left wedges between their 1.5 mm slices: IoU about 0.73 (groovetrace eval,
+  // the same joint rendered by `synth`). 0.88 with the seam smoothed over +-12 mm at this
+  // scale (robust/detect.cpp, at_scale); 0.925 with each slice also reaching over its half
+  // of the wedge (robust/label.cpp).
   EXPECT_GT(iou(d.groove, run.scan.truth.label, run.scan.cloud), 0.91);
 }
 

@@ -96,7 +96,7 @@ std::vector<SeamCandidate> trace_seams(const Context& ctx, const ConfirmedNodes&
 
 // The widest groove a scale's window holds with top surface on both sides, per metre of scale.
 constexpr double kWidthPerScale = 1.6;
-// The root's smoothing half-window along the seam per metre of scale (see at_scale).
+// The half-window of the smoothing along the seam per metre of scale (see at_scale).
 constexpr double kSmoothPerScale = 0.3;
 
 // The parameters of the search at `scale` (m): the crease radius and the section window
