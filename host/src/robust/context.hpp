@@ -27,9 +27,12 @@ struct Context {
 // --- surface.cpp ----------------------------------------------------------------------------
 
 /// `tangent` (unit) laid into the top surface at p, whose normal is taken from the voxels beside
-/// the groove; `normal` is the fallback and orientation of that normal.
+/// the groove; `normal` is the fallback and orientation of that normal. `curved`: the seam
+/// bends out of its surface (a pipe), whose normal at p is then that of a curved surface fitted
+/// to those voxels, not their plane's.
 Eigen::Vector3d surface_tangent(const Context& ctx, const Eigen::Vector3d& p,
-                                const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal);
+                                const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal,
+                                bool curved = false);
 
 /// Whether the surface with `normal` at p is seen at a slant from the viewpoint (where a gap in
 /// it may stand for a groove whose walls the sensor cannot see).
@@ -39,10 +42,10 @@ bool grazing(const Context& ctx, const Eigen::Vector3d& p, const Eigen::Vector3d
 
 /// Fits the section at `origin` (m) across `tangent` laid into the surface, the profile taken
 /// within `slab` (m) along it and oriented by `normal`; `scratch` holds the ball's points.
-/// `mode` as in fit_v_profile.
+/// `mode` as in fit_v_profile; `curved` as in surface_tangent.
 GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& tangent, const Eigen::Vector3d& normal, double slab,
-                         std::vector<std::uint32_t>& scratch, VFit mode = {});
+                         std::vector<std::uint32_t>& scratch, VFit mode = {}, bool curved = false);
 
 /// Traces one seam along its ordered node roots (m) with their surface normals: sections
 /// fitted at stations along it, twice, smoothed along it, and its ends extended and trimmed.

@@ -41,6 +41,16 @@ class StageTimer {
 std::string no_robust_groove(const RobustDetection& rd) {
   std::string why = std::to_string(rd.seams.size()) + " candidate seams";
   if (!rd.seams.empty()) why += ", none a V-groove (best: " + rd.seams.front().reason + ")";
+  // Where the search stopped, per scale: a groove with nodes but none confirmed failed its
+  // cross-section fit, one without candidates never stood out of the surface.
+  std::string per_scale;
+  for (const ScaleSearchSummary& s : rd.scales) {
+    per_scale += per_scale.empty() ? "" : ", ";
+    per_scale += std::to_string(static_cast<int>(std::lround(s.scale * 1000))) + " mm " +
+                 std::to_string(s.candidates) + "/" + std::to_string(s.nodes) + "/" +
+                 std::to_string(s.confirmed_nodes);
+  }
+  if (!per_scale.empty()) why += " (candidates/nodes/confirmed per scale: " + per_scale + ")";
   return "no groove found: " + std::to_string(rd.candidates) + " concave candidates, " + why;
 }
 
