@@ -390,6 +390,22 @@ TEST(RobustDetect, GirthSeamTorchTurnsWithThePipe) {
   EXPECT_LT(angle, 2.2);
 }
 
+// A 6 mm V (50 deg) at 0.45 m, 640x480: read over its whole 300 mm at the 10 mm scale, but
+// only over 152 mm at 5 mm, and the finer reading, ranked first, pushed the whole one out as
+// its repeat (robust/merge.cpp, reads_further).
+TEST(RobustDetect, NarrowGrooveIsKeptAtTheScaleThatReadsItWhole) {
+  SynthParams sp = vga_joint(316);
+  sp.groove_width = 0.006;
+  sp.groove_angle_deg = 50;
+  sp.distance = 0.45;
+  sp.tilt_deg = 5;
+  const JointRun run(sp);
+  ASSERT_GT(accepted_count(run.det), 0u);
+  const SeamCandidate& s = *best_accepted(run.det);
+  EXPECT_GT(s.length, 0.25);
+  EXPECT_LT(run.errors(s).first, 0.0015);
+}
+
 TEST(RobustDetect, RootOfTheAnalyticVGroove) {
   // tests/scenes.hpp: 640x480 at 0.4 m, tilted and turned, 10 mm wide and 4 mm deep, no gap.
   test::VGrooveScene sc;

@@ -69,8 +69,10 @@ void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double l
 /// The seams of every scale's search, ranked best first, without the ones that repeat a better
 /// seam: a seam is dropped when half or more of its root line runs within the groove (half its
 /// width, at least 3 mm) of a seam kept before it, or when it reads only the bottom of a wider,
-/// better scored groove found at a coarser scale. Order kept.
-std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked);
+/// better scored groove found at a coarser scale. Order kept. A repeat that reads the kept
+/// seam's groove half as long again, over all of it, and `fits_scale`, takes its place.
+std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked,
+                                                 bool (*fits_scale)(const SeamCandidate&));
 
 // --- support.cpp ----------------------------------------------------------------------------
 

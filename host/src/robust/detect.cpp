@@ -194,7 +194,8 @@ bool keep_before(const SeamCandidate& a, const SeamCandidate& b) {
 // The grooves of every scale, each at one scale: accepted first, then by scale_fit_score.
 std::vector<SeamCandidate> one_scale_per_groove(std::vector<SeamCandidate> all) {
   std::stable_sort(all.begin(), all.end(), keep_before);
-  std::vector<SeamCandidate> kept = robust_detail::drop_duplicate_scales(std::move(all));
+  std::vector<SeamCandidate> kept =
+      robust_detail::drop_duplicate_scales(std::move(all), fits_scale);
   std::stable_sort(kept.begin(), kept.end(), [](const SeamCandidate& a, const SeamCandidate& b) {
     if (a.accepted != b.accepted) return a.accepted;
     return scale_fit_score(a) > scale_fit_score(b);

@@ -199,9 +199,24 @@ bool bottom_of(const SeamCandidate& fine, const SeamCandidate& coarse) {
          fine.score < coarse.score && share_near(fine, coarse, 0.25 * coarse.width) >= 0.5;
 }
 
+// Within this of a seam (m, at least; else half its width) another runs in its groove.
+constexpr double kMinReach = 0.003;
+
+// Whether `longer`, a repeat of the kept seam `kept` read at another scale, reads the same
+// groove further: accepted, fitting its scale, half as long again and running along all of
+// `kept` (80 %). A 6 mm V at 640x480 and 0.45 m was read whole (300 mm) at 10 mm but only
+// over 150 mm at 5 mm, and the finer reading, ranked first, pushed the whole one out.
+bool reads_further(const SeamCandidate& longer, const SeamCandidate& kept,
+                   bool (*fits_scale)(const SeamCandidate&)) {
+  return longer.accepted && kept.accepted && fits_scale(longer) &&
+         longer.length >= 1.5 * kept.length &&
+         share_near(kept, longer, std::max(kMinReach, 0.5 * longer.width)) >= 0.8;
+}
+
 }  // namespace
 
-std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked) {
+std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> ranked,
+                                                 bool (*fits_scale)(const SeamCandidate&)) {
   std::vector<bool> part(ranked.size(), false);
   for (std::size_t i = 0; i < ranked.size(); ++i) {
     for (const SeamCandidate& other : ranked) part[i] = part[i] || bottom_of(ranked[i], other);
@@ -209,9 +224,11 @@ std::vector<SeamCandidate> drop_duplicate_scales(std::vector<SeamCandidate> rank
   std::vector<SeamCandidate> kept;
   for (std::size_t i = 0; i < ranked.size(); ++i) {
     bool repeats = part[i];
-    for (const SeamCandidate& k : kept) {
-      const double reach = std::max(0.003, 0.5 * k.width);
-      repeats = repeats || share_near(ranked[i], k, reach) >= 0.5;
+    for (SeamCandidate& k : kept) {
+      const double reach = std::max(kMinReach, 0.5 * k.width);
+      if (repeats || share_near(ranked[i], k, reach) < 0.5) continue;
+      repeats = true;
+      if (reads_further(ranked[i], k, fits_scale)) k = ranked[i];
     }
     if (!repeats) kept.push_back(std::move(ranked[i]));
   }
