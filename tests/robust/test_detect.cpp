@@ -406,6 +406,25 @@ TEST(RobustDetect, NarrowGrooveIsKeptAtTheScaleThatReadsItWhole) {
   EXPECT_LT(run.errors(s).first, 0.0015);
 }
 
+// A 4 mm V (60 deg) at 0.55 m, 1280x720, tilted 30 deg: read at 5 mm in two stretches 32 mm
+// apart, more than 3 links of that scale, and the longer, 190 mm, was the path (robust/
+// merge.cpp, bridge).
+TEST(RobustDetect, SmallGrooveStretchesAreJoinedAcrossTheirGap) {
+  SynthParams sp;
+  sp.width = 1280;
+  sp.height = 720;
+  sp.seed = 315;
+  sp.groove_width = 0.004;
+  sp.groove_angle_deg = 60;
+  sp.distance = 0.55;
+  sp.tilt_deg = 30;
+  const JointRun run(sp);
+  ASSERT_GT(accepted_count(run.det), 0u);
+  const SeamCandidate& s = *best_accepted(run.det);
+  EXPECT_GT(s.length, 0.25);
+  EXPECT_LT(run.errors(s).first, 0.0015);
+}
+
 TEST(RobustDetect, RootOfTheAnalyticVGroove) {
   // tests/scenes.hpp: 640x480 at 0.4 m, tilted and turned, 10 mm wide and 4 mm deep, no gap.
   test::VGrooveScene sc;
