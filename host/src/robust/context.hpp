@@ -62,6 +62,10 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
 
 // --- merge.cpp ------------------------------------------------------------------------------
 
+/// The gap (m) between two open seams that continue each other across it (each end's
+/// direction points at the other end within 30 deg), or infinity.
+double collinear_gap(const SeamCandidate& a, const SeamCandidate& b);
+
 /// Joins seams that are stretches of one (overlapping, touching or continuing each other
 /// across a gap of up to 3 `link`, m) and traces the joined ones again.
 void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link);
