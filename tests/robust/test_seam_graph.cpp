@@ -154,7 +154,7 @@ TEST(RobustSeamGraph, ExcursionOfTheNodePathIsNotACorner) {
 // its roots every 1.5 mm scattered by 1.5 mm across and in depth, as at 640x480 and 0.55 m.
 // Each stretch's end must still point at the other: the chord from the end to the root 10 mm
 // in turned up to 33 deg there and kept a sweep scan's two stretches apart (robust/merge.cpp,
-// end_direction); over these 20 draws it fails in about a quarter.
+// end_direction); over these 20 draws it failed in 4.
 TEST(RobustSeamGraph, NoisyStretchesOfOneSeamContinueEachOther) {
   auto stretch = [](double from, double to, std::mt19937& rng) {
     std::normal_distribution<double> scatter(0.0, 0.0015);

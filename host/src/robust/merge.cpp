@@ -39,6 +39,9 @@ Eigen::Vector3d end_direction(const SeamCandidate& s, int which) {
 
 double collinear_gap(const SeamCandidate& a, const SeamCandidate& b) {
   if (a.closed || b.closed || a.sections.size() < 2 || b.sections.size() < 2) return INFINITY;
+  // Each end's direction once (a fit over its last 20 mm), not once per pair of ends.
+  const Eigen::Vector3d dir_a[2] = {end_direction(a, 0), end_direction(a, 1)};
+  const Eigen::Vector3d dir_b[2] = {end_direction(b, 0), end_direction(b, 1)};
   double best = INFINITY;
   for (int ea = 0; ea < 2; ++ea) {
     for (int eb = 0; eb < 2; ++eb) {
@@ -48,8 +51,7 @@ double collinear_gap(const SeamCandidate& a, const SeamCandidate& b) {
       const double len = gap.norm();
       if (!(len > 0)) return 0.0;
       const double cos30 = 0.866;
-      if (end_direction(a, ea).dot(gap / len) > cos30 &&
-          end_direction(b, eb).dot(-gap / len) > cos30) {
+      if (dir_a[ea].dot(gap / len) > cos30 && dir_b[eb].dot(-gap / len) > cos30) {
         best = std::min(best, len);
       }
     }
