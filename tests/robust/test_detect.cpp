@@ -394,6 +394,21 @@ TEST(RobustDetect, GirthSeamTorchTurnsWithThePipe) {
   EXPECT_GT(iou(run.det.groove, run.scan.truth.label, run.scan.cloud), 0.96);
 }
 
+// A 4 mm V (60 deg) at 640x480, seen from 20 deg across the seam: its far wall gets one or two
+// image rows, which read flatter, and the seam read 10 deg asymmetric. Turned by that, the
+// torch stood 10.5 deg off the joint's bisector; a V's walls dip alike (align_bisectors).
+TEST(RobustDetect, NarrowVSeenAtASlantKeepsTheTorchOnItsBisector) {
+  SynthParams sp = vga_joint(313);
+  sp.groove_width = 0.004;
+  sp.groove_angle_deg = 60;
+  sp.tilt_deg = 20;
+  const JointRun run(sp);
+  ASSERT_GT(accepted_count(run.det), 0u);
+  const SeamCandidate& s = *best_accepted(run.det);
+  EXPECT_EQ(s.joint, "V");
+  EXPECT_LT(run.errors(s).second, 4.0);
+}
+
 // A 6 mm V (50 deg) at 0.45 m, 640x480: read over its whole 300 mm at the 10 mm scale, but
 // only over 152 mm at 5 mm, and the finer reading, ranked first, pushed the whole one out as
 // its repeat (robust/merge.cpp, reads_further).

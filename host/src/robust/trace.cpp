@@ -360,7 +360,8 @@ void anchor_one_wall_roots(std::vector<GrooveSection>& secs) {
 // than the steep, often half-hidden walls. The asymmetry is a property of the seam: its
 // median over the two-wall sections. Below kSymmetricDeg the groove is taken as symmetric
 // (what a D415 at a slant reads as asymmetry stays below that on symmetric V-grooves); above,
-// each section's bisector is the top normal turned by the median.
+// each section's bisector is the top normal turned by the median - on a single bevel only
+// (align_bisectors).
 constexpr double kSymmetricDeg = 8.0;
 
 // The seam's asymmetry (rad, about the tangent, from top normal to bisector): the median over
@@ -410,10 +411,15 @@ VFit seam_fit_mode(const std::vector<GrooveSection>& secs) {
   return mode;
 }
 
-void align_bisectors(std::vector<GrooveSection>& secs) {
+// A groove seam that is no single bevel (`mode`: the first pass's finding) has walls that dip
+// alike: the joints welded are symmetric V's and bevels. What it reads as asymmetry is the
+// view's: a narrow V seen at a slant gets one or two image rows on its far wall, which read
+// flatter, and a 4 mm V at 30 deg tilt read 15 deg asymmetric - the torch 15 deg off.
+void align_bisectors(std::vector<GrooveSection>& secs, const VFit& mode) {
   double turn = seam_asymmetry(secs);
   if (std::isnan(turn)) return;
-  if (std::abs(turn) < deg_to_rad(kSymmetricDeg)) turn = 0.0;
+  const bool v_groove = mode.kind == VFit::Kind::groove && mode.square == 0;
+  if (v_groove || std::abs(turn) < deg_to_rad(kSymmetricDeg)) turn = 0.0;
   for (auto& s : secs) {
     if (!s.ok && !s.inferred) continue;
     s.bisector = Eigen::AngleAxisd(turn, s.tangent.normalized()) * s.normal;
@@ -551,7 +557,7 @@ SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordere
     }
     seam.gap = open_root_gap(raw);
     anchor_one_wall_roots(raw);
-    align_bisectors(raw);
+    align_bisectors(raw, mode);
     std::vector<GrooveSection> smooth = smooth_sections(raw, curve, p.smooth);
     if (pass == 0 && !closed) {
       VFit ahead;  // the tracking fits as the first pass did: its own kind only
