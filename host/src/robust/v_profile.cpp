@@ -119,10 +119,18 @@ double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool 
   return rad_to_deg(std::atan2(left ? -cross : cross, inward.dot(wall)));
 }
 
+// Squared distance of p to (u, v) (m^2), in plain doubles as in vmodel.cpp: the fit's cost
+// asks near_vertex for every point at every trial step.
+double squared_distance(const Eigen::Vector2d& p, double u, double v) {
+  const double du = p.x() - u, dv = p.y() - v;
+  return du * du + dv * dv;
+}
+
 bool near_vertex(const Eigen::Vector2d& p, const VModel& m, double zone) {
   const double z2 = zone * zone;
-  return (p - m.root).squaredNorm() < z2 || (p - m.edge_left()).squaredNorm() < z2 ||
-         (p - m.edge_right()).squaredNorm() < z2;
+  return squared_distance(p, m.root.x(), m.root.y()) < z2 ||
+         squared_distance(p, m.u_left, m.top(m.u_left, false)) < z2 ||
+         squared_distance(p, m.u_right, m.top(m.u_right, true)) < z2;
 }
 
 using Mat6 = Eigen::Matrix<double, 6, 6>;
