@@ -57,6 +57,10 @@ struct GrooveSection {
   /// No V was measured here, only a gap of the groove's width in the top surface (walls at a
   /// grazing angle return nothing): root placed the seam's depth below the gap's centre.
   bool inferred = false;
+  /// No fit here either: past an open seam's last fit the groove still shows in a slab across
+  /// the seam's line (a part's end face blurs the fits of its last millimetres), and the end
+  /// section is carried on along that line.
+  bool extended = false;
   /// across = normal x tangent: u grows towards edge_right.
   Eigen::Vector3d across() const { return normal.cross(tangent).normalized(); }
 };

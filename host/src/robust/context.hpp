@@ -53,6 +53,23 @@ GrooveSection section_at(const Context& ctx, const Eigen::Vector3d& origin,
 SeamCandidate trace_seam(const Context& ctx, std::vector<Eigen::Vector3d> ordered,
                          std::vector<Eigen::Vector3d> normals, bool closed, bool corner);
 
+/// Where an open seam continues `steps` stations (params.station) past the last of `secs`, on
+/// the line through its last ok roots (m), and that line's unit direction, outwards. False
+/// with too few roots to tell.
+bool continue_seam(const Context& ctx, const std::vector<GrooveSection>& secs, int steps,
+                   Eigen::Vector3d& at, Eigen::Vector3d& tangent);
+
+/// The seam's length, arc lengths and corners measured along its sections' roots (m).
+void measure_along_roots(SeamCandidate& seam, bool closed);
+
+// --- seam_ends.cpp --------------------------------------------------------------------------
+
+/// Extends an open groove seam (V or bevel) at both ends, one station at a time along the line
+/// through its last roots, while a thin slab there still holds the groove and the top surface
+/// on both sides of it as the end section's does (up to params.scale), and measures it again.
+/// The added sections are not `ok` (no fit was made there); called once the seam is scored.
+void extend_to_groove_ends(const Context& ctx, SeamCandidate& seam);
+
 // --- section_smoothing.cpp ------------------------------------------------------------------
 
 /// The sections `raw` fitted at the stations of `curve`, smoothed along the seam over the

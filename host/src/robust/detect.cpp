@@ -152,6 +152,7 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
   for (SeamCandidate& seam : search.seams) {
     score_seam(seam, params);
     seam.scale = params.scale;
+    if (seam.accepted) robust_detail::extend_to_groove_ends(ctx, seam);
   }
   search.summary.seams = search.seams.size();
 }

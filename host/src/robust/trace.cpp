@@ -171,6 +171,8 @@ std::vector<GrooveSection> fit_stations(const Context& ctx, const SeamCurve& cur
   return secs;
 }
 
+}  // namespace
+
 // Where an open seam continues `steps` stations past the last of `secs`: a line in arc length
 // through the ok roots within 1.5 scale (15 mm) of arc back from the end, continued (over a few
 // millimetres a seam's bend is far below the tolerances of off_track), and its direction.
@@ -202,6 +204,8 @@ bool continue_seam(const Context& ctx, const std::vector<GrooveSection>& secs, i
   tangent = C.row(1).transpose().normalized();
   return at.allFinite() && tangent.allFinite();
 }
+
+namespace {
 
 // Whether a section tracked at `at` lies off the seam (another feature). Across the seam the
 // track must hold (3 mm). In depth a one-wall fit is looser (6 mm: its root is where the seen
@@ -469,6 +473,8 @@ void trim_ends(SeamCandidate& seam, double link) {
                                     secs.begin() + static_cast<std::ptrdiff_t>(hi));
 }
 
+}  // namespace
+
 // The seam's length, arc lengths and corners measured along its smoothed roots (for the score
 // and the region): each corner and tack moves to the station nearest its old arc length.
 void measure_along_roots(SeamCandidate& seam, bool closed) {
@@ -493,6 +499,8 @@ void measure_along_roots(SeamCandidate& seam, bool closed) {
   seam.curve.length = s;
   seam.curve.closed = closed;
 }
+
+namespace {
 
 // The tack welds along a seam: runs of at least three `filled` stations of `raw` (one station
 // that is neither filled nor ok may sit inside a run), each as its centre's arc length and its

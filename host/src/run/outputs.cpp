@@ -32,7 +32,9 @@ json stations_json(const SeamCandidate& seam) {
   auto num = finite_or_null;
   json out = json::array();
   for (const GrooveSection& s : seam.sections) {
-    const char* fit = !s.ok        ? (s.inferred ? "inferred" : "none")
+    const char* fit = !s.ok        ? (s.inferred   ? "inferred"
+                                      : s.extended ? "extended"
+                                                   : "none")
                       : s.corner   ? "corner"
                       : s.one_wall ? "one_wall"
                                    : "v";
