@@ -263,6 +263,25 @@ TEST(RobustDetect, SeamRunsToThePlatesEnds) {
   EXPECT_LT(hi, length + 0.0015);
 }
 
+// A groove that ends inside a plate (cut square at x = 0, the plate going on flat) is not
+// carried on past its end (robust/seam_ends.cpp): a slab there holds the top on both sides
+// but no walls. The fits stop 0.5 mm short of the end and the seam is carried to 1.0 mm past
+// it; carried on by its tops alone it ran 8.5 mm past.
+TEST(RobustDetect, GrooveEndingInsideThePlateStopsAtItsEnd) {
+  const test::HeightRender scene = test::render_plate_groove(
+      [](double x, double y) { return x > 0 ? 1.0 : std::abs(y); }, camera());
+  const RobustDetection d = detect_robust(scene.cloud, {});
+  ASSERT_GE(accepted_count(d), 1u);
+  const Trajectory t = seam_trajectory(*best_accepted(d), {});
+  const Eigen::Vector3d end = scene.to_camera(Eigen::Vector3d::Zero());
+  const Eigen::Vector3d along =
+      scene.T_world_camera.linear().transpose() * Eigen::Vector3d::UnitX();
+  double last = -INFINITY;
+  for (const Waypoint& w : t.waypoints) last = std::max(last, (w.position - end).dot(along));
+  EXPECT_GT(last, -0.004);
+  EXPECT_LT(last, 0.003);
+}
+
 // A single bevel (45 deg, 8 mm deep) seen from above: its square side returns nothing. Read
 // as a symmetric V, the path ran halfway up the inclined wall (3.7 mm across and 3.5 mm above
 // the root) with the torch 22.5 deg off the joint's bisector.
