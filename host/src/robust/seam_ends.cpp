@@ -74,7 +74,8 @@ bool holds(const SlabCounts& c, const SlabCounts& ref) {
 
 // Appends to `secs` copies of its last section moved one station at a time along the line
 // through its last roots (continue_seam), while the thin-slab test holds, up to one scale.
-void extend_back_to_end(const Context& ctx, std::vector<GrooveSection>& secs) {
+// `ds`: +1 where arc length grows towards the end (the seam's last end), -1 at its first.
+void extend_back_to_end(const Context& ctx, std::vector<GrooveSection>& secs, double ds) {
   const double station = ctx.params.station;
   Eigen::Vector3d at0, tangent;
   if (secs.empty() || !continue_seam(ctx, secs, 0, at0, tangent)) return;
@@ -89,6 +90,7 @@ void extend_back_to_end(const Context& ctx, std::vector<GrooveSection>& secs) {
     s.ok = s.inferred = s.filled = false;
     s.extended = true;
     s.why = "past the last fit: the groove continues in a thin slab";
+    s.s += ds * k * station;
     s.root += shift;
     s.edge_left += shift;
     s.edge_right += shift;
@@ -102,9 +104,9 @@ void extend_to_groove_ends(const Context& ctx, SeamCandidate& seam) {
   if (seam.closed || seam.corner) return;
   auto& secs = seam.sections;
   const std::size_t before = secs.size();
-  extend_back_to_end(ctx, secs);
+  extend_back_to_end(ctx, secs, +1);
   std::reverse(secs.begin(), secs.end());
-  extend_back_to_end(ctx, secs);
+  extend_back_to_end(ctx, secs, -1);
   std::reverse(secs.begin(), secs.end());
   if (secs.size() > before) measure_along_roots(seam, false);
   seam.length = seam.curve.length;
