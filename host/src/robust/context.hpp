@@ -65,7 +65,7 @@ void measure_along_roots(SeamCandidate& seam, bool closed);
 // --- seam_ends.cpp --------------------------------------------------------------------------
 
 /// Extends an open groove seam (V or bevel) at both ends, one station at a time along the line
-/// through its last roots, while a thin slab there still holds the groove and the top surface
+/// through its last roots, while a slab across it there still holds the groove and the top surface
 /// on both sides of it as the end section's does (up to params.scale), and measures it again.
 /// The added sections are not `ok` (no fit was made there); called once the seam is scored.
 void extend_to_groove_ends(const Context& ctx, SeamCandidate& seam);
