@@ -4,20 +4,13 @@
 #include <cmath>
 #include <groovetrace/error.hpp>
 
+#include "core/segment.hpp"
+
 namespace groovetrace::picture {
 namespace {
 
 std::uint8_t channel(double a, double b, double t) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(a + (b - a) * t, 0.0, 255.0)));
-}
-
-// Distance (pixels) from p to the segment a-b.
-double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                        const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
 }
 
 }  // namespace

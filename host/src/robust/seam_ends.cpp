@@ -12,6 +12,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/segment.hpp"
 #include "robust/context.hpp"
 
 namespace groovetrace::robust_detail {
@@ -22,14 +23,6 @@ namespace {
 struct SlabCounts {
   int groove = 0, left = 0, right = 0;
 };
-
-// Distance (m) from p to the segment from a to b, in the plane of a cross-section.
-double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                        const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
-  return (a + t * ab - p).norm();
-}
 
 // An end section's profile in the plane across the unit `along`: u across (towards its right
 // edge), h along its top normal, both from the middle of its opening (m).
@@ -70,9 +63,9 @@ SlabCounts count_slab(const Context& ctx, const EndProfile& e, const Eigen::Vect
     const Eigen::Vector3d r = ctx.cloud.point(j).cast<double>() - centre;
     const Eigen::Vector2d q(r.dot(e.across), r.dot(e.out));
     const double top = q.x() < e.foot.x() ? e.left.y() : e.right.y();  // that side's rim height
-    const double off =
-        std::min(segment_distance(q, e.left, e.foot), segment_distance(q, e.foot, e.right));
-    if (q.y() < top - tol && off <= tol) {
+    // Below the rim and on a wall; the walls' distances only for points below a rim.
+    if (q.y() < top - tol && std::min(segment_distance(q, e.left, e.foot),
+                                      segment_distance(q, e.foot, e.right)) <= tol) {
       ++c.groove;
     } else if (q.x() < e.left.x() && q.x() >= e.left.x() - width) {
       c.left += std::abs(q.y() - e.left.y()) <= tol;
@@ -111,9 +104,8 @@ Eigen::Vector3d end_normal(const std::vector<GrooveSection>& secs, double reach)
 // The line is laid into the top surface of those same 15 mm (their mean normal): the roots'
 // depth noise tilts it, and carried 18 mm on at 640x480 and 0.55 m it ran 3.9 mm deep (2.5
 // laid in). Not into the end section's own: one noisy normal turned it off the part (a 60 mm
-// joint's coverage 96 -> 92 %). `sign`: +1 where
-// arc length grows towards this end, -1 at the seam's first end. An end whose V was not measured
-// (`inferred`) is not carried on.
+// joint's coverage 96 -> 92 %). `sign`: +1 where arc length grows towards this end, -1 at the
+// seam's first end. An end whose V was not measured (`inferred`) is not carried on.
 void extend_back_to_end(const Context& ctx, std::vector<GrooveSection>& secs, double sign) {
   const double station = ctx.params.station, half = ctx.params.slab;
   Eigen::Vector3d at, tangent;  // `at`: where the line passes the end (unused)
