@@ -50,8 +50,11 @@ struct RobustParams {
   std::vector<double> scales = {0.005, 0.010, 0.020, 0.040};
   double cell = 0.001;       ///< voxel edge of the coarse cloud the candidates live on (m)
   double threshold_k = 4.0;  ///< candidate: concavity > median + k * robust sigma
-  double station = 0.0015;   ///< spacing of the fitted cross-sections along a seam (m)
-  double slab = 0.0015;      ///< half-thickness of a cross-section along the seam (m)
+  /// When no seam is accepted at `threshold_k`, the search runs once more with this k (0 or
+  /// >= threshold_k: never; docs/method-robust.md, "A second search").
+  double retry_threshold_k = 3.0;
+  double station = 0.0015;  ///< spacing of the fitted cross-sections along a seam (m)
+  double slab = 0.0015;     ///< half-thickness of a cross-section along the seam (m)
   /// Half-window of the smoothing along the seam (m): the seam's curve and roots over it, the
   /// groove's shape over 5 times it. At scales beyond 20 mm, 0.3 times the scale.
   double smooth = 0.006;

@@ -132,6 +132,8 @@ struct RobustDetection {
   Normals normals;                   ///< per input point: its voxel's plane normal at `scale`
   double threshold = 0.0;            ///< candidate concavity threshold (m)
   double noise_sigma = 0.0;          ///< robust sigma of the concavity (m)
+  double threshold_k = 0.0;          ///< the threshold's k (robust sigmas) of this result
+  bool retried = false;              ///< a second search at retry_threshold_k ran
   std::size_t candidates = 0;        ///< voxels above the threshold
   std::size_t nodes = 0;             ///< crease nodes after non-maximum suppression
   std::size_t confirmed_nodes = 0;   ///< nodes whose cross-section is a V

@@ -128,6 +128,8 @@ json robust_report(const RobustDetection& rd, const std::vector<Trajectory>& tra
   }
   return {{"concavity_threshold_m", rd.threshold},
           {"concavity_sigma_m", rd.noise_sigma},
+          {"threshold_k", rd.threshold_k},
+          {"retried", rd.retried},
           {"candidate_voxels", rd.candidates},
           {"crease_nodes", rd.nodes},
           {"confirmed_nodes", rd.confirmed_nodes},

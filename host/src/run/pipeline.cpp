@@ -51,6 +51,7 @@ std::string no_robust_groove(const RobustDetection& rd) {
                  std::to_string(s.confirmed_nodes);
   }
   if (!per_scale.empty()) why += " (candidates/nodes/confirmed per scale: " + per_scale + ")";
+  if (rd.retried) why += "; searched again with a lower threshold: none either";
   return "no groove found: " + std::to_string(rd.candidates) + " concave candidates, " + why;
 }
 
