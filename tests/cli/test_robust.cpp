@@ -185,6 +185,10 @@ TEST_F(CliRobust, NoGrooveExitsWithFour) {
       "run " + scan.string() + " -o " + (dir_ / "out").string() + " --method robust -q", dir_);
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("no groove"), std::string::npos) << r.err;
+  // Nothing accepted: the second search ran (at RobustParams::retry_threshold_k) and the line
+  // says so.
+  EXPECT_NE(r.err.find("searched again with a lower threshold: none either"), std::string::npos)
+      << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out" / "trajectory.csv"));
 }
