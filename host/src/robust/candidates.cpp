@@ -232,10 +232,14 @@ CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBack
   const auto [median, sigma] = robust_location_scale(map.concavity);
   map.median = median;
   map.sigma = sigma;
+  set_threshold(map, params);
+  return map;
+}
+
+void set_threshold(CreaseMap& map, const RobustParams& params) {
   // The floor keeps noise-free scans, whose flats have sigma ~ 0, from turning float rounding
   // into candidates; 1% of the scale is far below any groove the scale is meant for.
-  map.threshold = median + std::max(params.threshold_k * sigma, 0.01 * params.scale);
-  return map;
+  map.threshold = map.median + std::max(params.threshold_k * map.sigma, 0.01 * params.scale);
 }
 
 Cloud voxel_cloud(const CreaseMap& map) {

@@ -123,8 +123,10 @@ struct ScaleSearch {
   std::vector<SeamCandidate> seams;
 };
 
-ScaleSearch find_creases(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend) {
-  ScaleSearch out{params, 0, INFINITY, crease_map(cloud, params, backend), {}, {}, {}};
+// The search at `params.scale` on its crease `map`: the candidates above the map's threshold
+// and their nodes.
+ScaleSearch search_on(const RobustParams& params, CreaseMap map) {
+  ScaleSearch out{params, 0, INFINITY, std::move(map), {}, {}, {}};
   ScaleSearchSummary& sum = out.summary;
   sum.scale = params.scale;
   sum.cell = params.cell;
@@ -133,6 +135,10 @@ ScaleSearch find_creases(const Cloud& cloud, const RobustParams& params, Feature
   out.nodes = crease_nodes(out.map, params);
   sum.nodes = out.nodes.voxel.size();
   return out;
+}
+
+ScaleSearch find_creases(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend) {
+  return search_on(params, crease_map(cloud, params, backend));
 }
 
 void trace_scale(const Cloud& cloud, ScaleSearch& search) {
@@ -218,14 +224,9 @@ bool any_accepted(const std::vector<SeamCandidate>& seams) {
   return std::any_of(seams.begin(), seams.end(), [](const SeamCandidate& s) { return s.accepted; });
 }
 
-// Stages 1-3 at every scale with the candidates above `threshold_k`: the grooves, one scale
-// each, without the per-point labels. `lap` gets each stage's name after `prefix`.
-RobustDetection search_scales(const Cloud& cloud, const RobustParams& params,
-                              FeatureBackend& backend,
-                              const std::function<void(const std::string&)>& lap,
-                              const std::string& prefix) {
-  RobustDetection det;
-  det.threshold_k = params.threshold_k;
+// Stage 1 at every scale: the crease maps and their nodes.
+std::vector<ScaleSearch> find_all_creases(const Cloud& cloud, const RobustParams& params,
+                                          FeatureBackend& backend) {
   std::vector<double> scales = params.scales;
   if (std::find(scales.begin(), scales.end(), params.scale) == scales.end()) {
     scales.push_back(params.scale);
@@ -235,12 +236,34 @@ RobustDetection search_scales(const Cloud& cloud, const RobustParams& params,
   for (double scale : scales)
     searches.push_back(find_creases(cloud, at_scale(params, scale), backend));
   width_bands(searches, params.scale);
-  if (lap) lap(prefix + "candidates");
+  return searches;
+}
+
+// The same searches with the candidates' threshold at `k` robust sigmas: the crease maps are
+// kept (the measure does not depend on k), the candidates and nodes found again.
+void rethreshold(std::vector<ScaleSearch>& searches, double k) {
+  for (ScaleSearch& s : searches) {
+    RobustParams p = s.params;
+    p.threshold_k = k;
+    set_threshold(s.map, p);
+    const double lo = s.lo, hi = s.hi;
+    s = search_on(p, std::move(s.map));
+    s.lo = lo;
+    s.hi = hi;
+  }
+}
+
+// Stages 2-3 on every scale's search: the grooves, one scale each, without the per-point
+// labels; the fields of the search at `params.scale` (the base) reported.
+RobustDetection trace_searches(const Cloud& cloud, std::vector<ScaleSearch>& searches,
+                               double base) {
+  RobustDetection det;
   std::vector<SeamCandidate> all;
   for (ScaleSearch& search : searches) {
     trace_scale(cloud, search);
-    if (search.params.scale == params.scale) {
+    if (search.params.scale == base) {
       per_point_fields(cloud, search.map, det);
+      det.threshold_k = search.params.threshold_k;
       det.threshold = search.map.threshold;
       det.noise_sigma = search.map.sigma;
       det.candidates = search.summary.candidates;
@@ -255,7 +278,6 @@ RobustDetection search_scales(const Cloud& cloud, const RobustParams& params,
   for (ScaleSearchSummary& sum : det.scales) {
     for (const SeamCandidate& seam : det.seams) sum.kept += (seam.scale == sum.scale);
   }
-  if (lap) lap(prefix + "seams");
   return det;
 }
 
@@ -265,16 +287,20 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                               FeatureBackend& backend,
                               const std::function<void(const std::string&)>& lap) {
   require_in_range(cloud);  // the voxel keys of every scale stay far inside 64 bits
-  RobustDetection det = search_scales(cloud, params, backend, lap, "");
-  // Nothing accepted: once more with the candidates' threshold lowered (docs/method-robust.md,
-  // "A second search"). The V fits, not the threshold, decide what a groove is; the threshold
-  // only keeps their number down, and at 0.70 m and 640x480 a 10 mm V's root stands 2-3
-  // sigmas above the flats.
+  std::vector<ScaleSearch> searches = find_all_creases(cloud, params, backend);
+  if (lap) lap("candidates");
+  RobustDetection det = trace_searches(cloud, searches, params.scale);
+  if (lap) lap("seams");
+  // Nothing accepted: once more with the candidates' threshold lowered, on the same crease
+  // maps (docs/method-robust.md, "A second search"). The V fits, not the threshold, decide
+  // what a groove is; the threshold only keeps their number down, and at 0.70 m and 640x480 a
+  // 10 mm V's root stands 2-3 sigmas above the flats.
   const double retry_k = params.retry_threshold_k;
   if (!any_accepted(det.seams) && retry_k > 0 && retry_k < params.threshold_k) {
-    RobustParams again = params;
-    again.threshold_k = retry_k;
-    RobustDetection second = search_scales(cloud, again, backend, lap, "retry_");
+    rethreshold(searches, retry_k);
+    if (lap) lap("retry_candidates");
+    RobustDetection second = trace_searches(cloud, searches, params.scale);
+    if (lap) lap("retry_seams");
     det.retried = true;
     if (any_accepted(second.seams)) {
       second.retried = true;

@@ -35,6 +35,10 @@ struct CreaseMap {
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params, FeatureBackend& backend);
 CreaseMap crease_map(const Cloud& cloud, const RobustParams& params);
 
+/// Sets `map.threshold` (m) from its median and sigma: median + params.threshold_k * sigma,
+/// never below 1 % of params.scale.
+void set_threshold(CreaseMap& map, const RobustParams& params);
+
 /// The voxel centroids of `map` as an unorganized cloud (same frame, metres; the map's
 /// viewpoint): what FeatureBackend::crease measures.
 Cloud voxel_cloud(const CreaseMap& map);
