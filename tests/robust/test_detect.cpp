@@ -643,5 +643,40 @@ TEST(RobustDetect, EmptyAndFlatScansFindNothing) {
   EXPECT_EQ(accepted_count(detect_robust(flat.cloud, RobustParams{})), 0u);
 }
 
+// Every pixel of `scan` labelled as joint moved along its ray onto the part's top plane
+// (z = thickness in the workpiece frame): a plate with no groove, its clamps and bars kept.
+void fill_joint(SynthScan& scan) {
+  const SynthTruth& t = scan.truth;
+  const int width = t.camera.width;
+  for (std::size_t i = 0; i < t.label.size(); ++i) {
+    if (!t.label[i]) continue;
+    const Eigen::Vector3d ray =
+        t.camera.ray(static_cast<double>(i % width), static_cast<double>(i / width));
+    const double along = t.T_workpiece_camera.linear().row(2).dot(ray);
+    const double range = (t.groove.thickness - t.T_workpiece_camera.translation().z()) / along;
+    const Eigen::Vector3f p = (range * ray).cast<float>();
+    scan.cloud.x[i] = p.x();
+    scan.cloud.y[i] = p.y();
+    scan.cloud.z[i] = p.z();
+  }
+}
+
+// A plate with two clamps and a loose bar on the table beside it, its joint filled in (the
+// sweep's no-joint scene s402): between the plate's edge and the bar the table shows as a
+// floor 10 mm wide and 12 mm down, and the plate's rim and the bar's face were read as a bevel
+// 20 mm deep at the 40 mm scale. A V's opening holds no points inside its walls away from its
+// root; this channel's floor lies there in most of its sections.
+TEST(RobustDetect, ChannelBesideALooseBarIsNoJoint) {
+  SynthParams sp;
+  sp.clamps = 2;
+  sp.clutter = 1;
+  sp.distance = 0.35;
+  sp.tilt_deg = -15;
+  sp.seed = 402;
+  SynthScan scan = render(sp);
+  fill_joint(scan);
+  EXPECT_EQ(accepted_count(detect_robust(scan.cloud, RobustParams{})), 0u);
+}
+
 }  // namespace
 }  // namespace groovetrace

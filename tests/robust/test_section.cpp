@@ -124,6 +124,24 @@ TEST(RobustSection, RootGapIsMeasuredFromTheSlot) {
   }
 }
 
+TEST(RobustSection, RootGapSlotIsNotAFloor) {
+  // The floor test (VProfile::inside: points inside the walls away from the root) leaves out
+  // a 2 mm root gap's slot, where the table shows below the walls beside the root, and a clean
+  // V has nothing there; a channel's floor between a plate and a bar is what it counts.
+  VFit seam_with_gap;
+  seam_with_gap.root_gap = true;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    for (const VFit& mode : {VFit{}, seam_with_gap}) {
+      const VProfile g = fit_v_profile(gapped_v_profile(0.002, 0.0002, seed), 0.02, mode);
+      ASSERT_TRUE(g.ok) << g.why;
+      EXPECT_LT(g.inside, 0.02) << seed;
+    }
+    const VProfile v = fit_v_profile(v_profile(0.008, 60, 60, 0.0, 0.0003, seed), 0.02);
+    ASSERT_TRUE(v.ok) << v.why;
+    EXPECT_LT(v.inside, 0.02) << seed;
+  }
+}
+
 TEST(RobustSection, OneWallSeenKeepsTheOpeningAndRoot) {
   // The left wall of a 60 deg V returns nothing. Seen from 20 deg to the left it faces the
   // sensor at 80 deg incidence (grazing): the top ends at its rim, the V is taken symmetric.

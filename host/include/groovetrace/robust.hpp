@@ -46,6 +46,9 @@ struct GrooveSection {
   /// The root gap measured at this station (m; two-wall V's, else 0). Once the seam's gap is
   /// applied, `root` is the middle of the opening at the root faces and `depth` is to there.
   double gap = 0;
+  /// The share of the fitted V's opening points that lie inside its walls away from the root
+  /// (a channel's floor, not a V; 0 on a clean V).
+  double inside = 0;
   /// A concave corner between two faces (a fillet or lap joint), not a V: the edges are the
   /// weld's leg ends on the faces, `normal` and `bisector` the corner's bisector.
   bool corner = false;

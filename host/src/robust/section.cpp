@@ -196,6 +196,7 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
   sec.wall_right_deg = f.wall_right_deg;
   sec.misalignment = f.misalignment;
   sec.gap = f.gap;
+  sec.inside = f.inside;
   sec.corner = f.corner;
   sec.short_face = f.short_face;
   return sec;

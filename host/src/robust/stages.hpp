@@ -83,6 +83,9 @@ struct VProfile {
   /// Two-wall V's: the root gap's width estimated from the points below the walls (m, 0 when
   /// none; v_profile.cpp, step 7). `root` stays the walls' intersection.
   double gap = 0.0;
+  /// The share of the opening's points that lie inside the walls, away from the root (a floor;
+  /// v_profile.cpp, in_walls).
+  double inside = 0.0;
   /// A concave corner between two faces with no top (fit_corner_profile): a fillet or lap
   /// joint. Edges are the weld's leg ends on the faces, `top` the weld face between them.
   bool corner = false;

@@ -332,13 +332,27 @@ struct PieceStats {
   double wall_rms = 0;          // rms distance of the wall inliers
   double top_sigma = 0;         // robust sigma of the top inliers
   double top_outliers = 0;      // share of the outer points that do not fit the top
+  double inside = 0;            // share of the opening's points inside the walls (in_walls)
 };
+
+// Half the widest root opening a joint has (m): a root gap's slot shows the table below the
+// walls within this of the root, plus the vertex zone.
+constexpr double kMaxHalfGap = 0.0015;
+
+// Whether profile point p (signed distance r to `m`) lies inside the walls of `m`, clearly
+// (beyond the Tukey cut c) and away from the root (beyond a fifth of the opening, and beyond
+// the vertex zone and the widest root gap): a V shows no points there, a channel with a floor
+// does (score.cpp, kMaxFloored).
+bool in_walls(const Eigen::Vector2d& p, double r, const VModel& m, double c, double zone) {
+  const double keep = std::max(0.2 * (m.u_right - m.u_left), zone + kMaxHalfGap);
+  return r < -c && std::abs(p.x() - m.root.x()) > keep;
+}
 
 PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m, double scale,
                        double zone) {
   PieceStats st;
   double ss = 0;
-  int nw = 0, outer = 0, outer_bad = 0;
+  int nw = 0, outer = 0, outer_bad = 0, opening = 0, inside = 0;
   std::vector<double> top_r;
   const double c = kTukeyC * scale;
   for (const auto& p : pts) {
@@ -347,6 +361,10 @@ PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m,
     if (is_top && (p.x() < m.u_left - zone || p.x() > m.u_right + zone)) {
       ++outer;
       if (std::abs(r) >= c) ++outer_bad;
+    }
+    if (p.x() > m.u_left && p.x() < m.u_right) {
+      ++opening;
+      inside += in_walls(p, r, m, c, zone);
     }
     if (near_vertex(p, m, zone) || std::abs(r) >= c) continue;
     ++st.count[piece];
@@ -360,6 +378,7 @@ PieceStats piece_stats(const std::vector<Eigen::Vector2d>& pts, const VModel& m,
   st.wall_rms = nw > 0 ? std::sqrt(ss / nw) : 0;
   st.top_sigma = robust_sigma(top_r);
   st.top_outliers = outer > 0 ? static_cast<double>(outer_bad) / outer : 1.0;
+  st.inside = opening > 0 ? static_cast<double>(inside) / opening : 0.0;
   return st;
 }
 
@@ -561,6 +580,7 @@ VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   VProfile o = describe_v(v, st, f.sigma);
   o.one_wall = one_wall;
   o.misalignment = f.top_step;
+  o.inside = st.inside;
   const char* why = why_not_v(o, st, f, one_wall ? 0 : kMinWall);
   if (why) {
     o.why = why;
