@@ -135,6 +135,49 @@ TEST_F(CliRobust, FilletReportsItsJointAndTheWeldsLeg) {
   EXPECT_NEAR(angles[angles.size() / 2], 90.0, 3.0);
 }
 
+// report.json's stations and tacks count their arc length as the trajectory runs, like
+// max_rotation_at_m: this seam is traced from its far end (larger x), and its tacks were
+// reported at 300 mm minus their place. Against the renderer's tacks (the truth's seam runs
+// the same way as the path: towards larger x).
+TEST_F(CliRobust, StationsAndTacksRunWithTheTrajectory) {
+  const fs::path scan = dir_ / "tacks.pcd";
+  const auto s = test::run_cli(
+      "synth --shape straight --tacks 3 --tack-height 0.7 --resolution "
+      "640x480 --distance 0.4 --tilt 20 --seed 354 -o " +
+          scan.string(),
+      dir_);
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  const fs::path out = dir_ / "out";
+  const auto r = test::run_cli("run " + scan.string() + " -q -o " + out.string(), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(out / "report.json"));
+  const auto& seam = report["robust"]["seams"].at(0);
+  const auto path = nlohmann::json::parse(test::read_text(out / "trajectory.json"));
+  const auto& first = path["waypoints"].front()["position_m"];
+  const auto& stations = seam["stations"];
+  ASSERT_GT(stations.size(), 100u);
+  double gap = 0, last_s = -1;
+  for (int i = 0; i < 3; ++i) {
+    gap = std::max(gap, std::abs(stations[0]["root_m"][i].get<double>() - first[i].get<double>()));
+  }
+  EXPECT_LT(gap, 0.003);
+  for (const auto& st : stations) {
+    EXPECT_GT(st["s_m"].get<double>(), last_s);
+    last_s = st["s_m"].get<double>();
+  }
+  const auto truth = nlohmann::json::parse(test::read_text(dir_ / "tacks.truth.json"));
+  const auto& tacks = truth["seams"].at(0)["tacks"];
+  ASSERT_GE(seam["tacks"].size(), 2u);
+  for (const auto& found : seam["tacks"]) {
+    double nearest = 1.0;
+    for (const auto& t : tacks) {
+      nearest = std::min(
+          nearest, std::abs(found["position_m"].get<double>() - t["position_m"].get<double>()));
+    }
+    EXPECT_LT(nearest, 0.008) << found.dump();
+  }
+}
+
 TEST_F(CliRobust, StepSlicesAndMaxSeams) {
   // Two parallel straight grooves 40 mm apart.
   const fs::path scan = write_scan(

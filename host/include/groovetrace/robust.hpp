@@ -115,6 +115,10 @@ struct SeamCandidate {
 /// normal and ends where it started.
 GT_API Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
+/// Whether seam_trajectory runs the open `seam` from its last section to its first: a path
+/// travels towards larger x of the cloud's frame (ties: y, then z). False for a closed seam.
+GT_API bool travels_backwards(const SeamCandidate& seam);
+
 /// What the search at one scale found (RobustParams::scales).
 struct ScaleSearchSummary {
   double scale = 0.0;               ///< m

@@ -33,13 +33,17 @@ void orient_ring(std::vector<GrooveSection>& secs) {
   if (turn.dot(up) < 0) std::reverse(secs.begin() + 1, secs.end());
 }
 
+// Whether an open seam from `first` to `last` (roots, m) runs towards smaller x (ties: y, then z).
+bool backwards(const Eigen::Vector3d& first, const Eigen::Vector3d& last) {
+  const Eigen::Vector3d d = last - first;
+  const double eps = 1e-9;
+  return d.x() < -eps ||
+         (std::abs(d.x()) <= eps && (d.y() < -eps || (std::abs(d.y()) <= eps && d.z() < 0)));
+}
+
 // An open seam ends at larger x than it starts (ties: y, then z).
 void orient_open(std::vector<GrooveSection>& secs) {
-  const Eigen::Vector3d d = secs.back().root - secs.front().root;
-  const double eps = 1e-9;
-  const bool backwards = d.x() < -eps || (std::abs(d.x()) <= eps &&
-                                          (d.y() < -eps || (std::abs(d.y()) <= eps && d.z() < 0)));
-  if (backwards) std::reverse(secs.begin(), secs.end());
+  if (backwards(secs.front().root, secs.back().root)) std::reverse(secs.begin(), secs.end());
 }
 
 // Drops the roots where the path folds back on itself (the chords before and after turn by
@@ -231,6 +235,11 @@ Waypoint waypoint_at(const TorchPath& path, std::size_t seg, double f,
 }
 
 }  // namespace
+
+bool travels_backwards(const SeamCandidate& seam) {
+  const auto& secs = seam.sections;
+  return !seam.closed && !secs.empty() && backwards(secs.front().root, secs.back().root);
+}
 
 Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params) {
   std::vector<GrooveSection> secs = seam.sections;

@@ -25,13 +25,22 @@ using nlohmann::json;
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-// The fitted cross-section at every station of a seam (docs/method-robust.md, "Score"):
-// arc length and root (m, the cloud's frame), opening width, depth, included angle, high-low,
-// and how the station was fitted.
+// Arc length `s` (m) of `seam` counted as its trajectory runs (travels_backwards: from its last
+// section).
+double along_travel(const SeamCandidate& seam, double s) {
+  if (!travels_backwards(seam)) return s;
+  return seam.sections.front().s + seam.sections.back().s - s;
+}
+
+// The fitted cross-section at every station of a seam, in the trajectory's order
+// (docs/method-robust.md, "Score"): arc length and root (m, the cloud's frame), opening width,
+// depth, included angle, high-low, and how the station was fitted.
 json stations_json(const SeamCandidate& seam) {
   auto num = finite_or_null;
   json out = json::array();
-  for (const GrooveSection& s : seam.sections) {
+  std::vector<GrooveSection> secs = seam.sections;
+  if (travels_backwards(seam)) std::reverse(secs.begin(), secs.end());
+  for (const GrooveSection& s : secs) {
     const char* fit = !s.ok        ? (s.inferred   ? "inferred"
                                       : s.extended ? "extended"
                                                    : "none")
@@ -39,7 +48,7 @@ json stations_json(const SeamCandidate& seam) {
                       : s.one_wall ? "one_wall"
                                    : "v";
     out.push_back(
-        {{"s_m", num(s.s)},
+        {{"s_m", num(along_travel(seam, s.s))},
          {"root_m", {num(s.root.x()), num(s.root.y()), num(s.root.z())}},
          {"opening_m", num(s.width)},
          {"depth_m", num(s.depth)},
@@ -52,12 +61,14 @@ json stations_json(const SeamCandidate& seam) {
   return out;
 }
 
-// The tack welds found along a seam: arc length of each one's centre and its length (m).
+// The tack welds found along a seam, in the trajectory's order: arc length of each one's centre
+// (as the stations') and its length (m).
 json tacks_json(const SeamCandidate& seam) {
   json out = json::array();
   for (const SeamCandidate::Tack& t : seam.tacks)
-    out.push_back(
-        {{"position_m", finite_or_null(t.position)}, {"length_m", finite_or_null(t.length)}});
+    out.push_back({{"position_m", finite_or_null(along_travel(seam, t.position))},
+                   {"length_m", finite_or_null(t.length)}});
+  if (travels_backwards(seam)) std::reverse(out.begin(), out.end());
   return out;
 }
 
