@@ -58,6 +58,37 @@ std::vector<gt::ToolPose> line_poses(double x0, double x1, int n, const Eigen::V
   return poses;
 }
 
+// A run output in `out` that detects exactly the truth of `scan` (annotated.pcd) and follows its
+// first seam's root line (trajectory.csv, every 10th vertex; from its end when `backwards`), tool
+// z = -normal and x along the travel.
+void write_run(const gt::SynthScan& scan, const std::filesystem::path& out, bool backwards) {
+  gt::Normals normals;
+  normals.resize(scan.cloud.size());
+  std::fill(normals.z.begin(), normals.z.end(), -1.0f);
+  const std::vector<float> descriptor(scan.cloud.size(), 1.0f);
+  gt::write_file_atomic(
+      (out / "annotated.pcd").string(),
+      gt::annotated_pcd_bytes(scan.cloud, {&normals, &descriptor, &scan.truth.label}));
+  const gt::Seam& seam = scan.truth.seams[0];
+  std::ofstream csv(out / "trajectory.csv");
+  csv << "idx,x_m,y_m,z_m,qx,qy,qz,qw,rx,ry,rz\n";
+  csv.precision(17);
+  const Eigen::Vector3d x =
+      (seam.root.back() - seam.root.front()).normalized() * (backwards ? -1 : 1);
+  for (std::size_t j = 0; j < seam.root.size(); j += 10) {
+    const std::size_t k = backwards ? seam.root.size() - 1 - j : j;
+    const Eigen::Vector3d z = -seam.normal[k];
+    Eigen::Matrix3d R;
+    R.col(0) = (x - x.dot(z) * z).normalized();
+    R.col(2) = z;
+    R.col(1) = z.cross(R.col(0));
+    const Eigen::Quaterniond q(R);
+    const Eigen::Vector3d& r = seam.root[k];
+    csv << j / 10 << "," << r.x() << "," << r.y() << "," << r.z() << "," << q.x() << "," << q.y()
+        << "," << q.z() << "," << q.w() << ",0,0,0\n";
+  }
+}
+
 }  // namespace
 
 TEST(Eval, PerfectDetectionIsIoU100) {
@@ -143,6 +174,38 @@ TEST(Eval, EveryExportedSeamAgainstEveryTrueOne) {
       << text;
 }
 
+// Tacks placed on a path that runs against the root's direction (arc lengths from the path's
+// start, x = 0.1 - s), scored along the root: nearest pairs first, each tack used once.
+TEST(Eval, TacksMatchAlongTheRoot) {
+  gt::SynthTruth t = hand_truth();
+  const auto tack = [](double s, double length) {
+    gt::Tack k;
+    k.position = s;
+    k.centre = {-0.1 + s, 0, 0.4};
+    k.length = length;
+    return k;
+  };
+  t.seams[0].tacks = {tack(0.05, 0.010), tack(0.15, 0.012), tack(0.18, 0.008)};
+  const std::vector<gt::ReportedTack> reported = {
+      {0.151, 0.008},  // x -0.051: the first tack, 1 mm off, 2 mm short
+      {0.148, 0.010},  // x -0.048: 2 mm off the same tack, which the nearer one took
+      {0.050, 0.012},  // x 0.05: the second tack exactly
+      {0.190, 0.006},  // x -0.09: no tack there
+  };
+  const gt::TackScore s = gt::score_tacks(t, line_poses(0.1, -0.1, 41, {0, 0, 0}), reported);
+  EXPECT_EQ(s.expected, 3u);
+  EXPECT_EQ(s.found, 2u);
+  EXPECT_EQ(s.extra, 2u);
+  EXPECT_NEAR(s.position_mean, 0.0005, 1e-9);
+  EXPECT_NEAR(s.position_max, 0.001, 1e-9);
+  EXPECT_NEAR(s.length_bias, -0.001, 1e-9);
+  // A path 7 mm beside the seam (beyond the 6 mm coverage radius) places no tack on it.
+  const gt::TackScore off = gt::score_tacks(t, line_poses(0.1, -0.1, 41, {0, 0.007, 0}), reported);
+  EXPECT_EQ(off.found, 0u);
+  EXPECT_EQ(off.extra, 4u);
+  EXPECT_TRUE(std::isnan(off.position_mean));
+}
+
 TEST(Eval, DepthOffsetIsDepthError) {
   const gt::SynthTruth t = hand_truth();
   // 1 mm towards the camera (-z): above the root, positive along the outward normal.
@@ -207,34 +270,7 @@ TEST(Eval, ReadsARunDirectory) {
   const std::string scan_path = (dir / "scan.pcd").string();
   gt::write_synth_scan(scan, scan_path);
 
-  {
-    gt::Normals normals;
-    normals.resize(scan.cloud.size());
-    std::fill(normals.z.begin(), normals.z.end(), -1.0f);
-    const std::vector<float> descriptor(scan.cloud.size(), 1.0f);
-    gt::write_file_atomic(
-        (dir / "out" / "annotated.pcd").string(),
-        gt::annotated_pcd_bytes(scan.cloud, {&normals, &descriptor, &scan.truth.label}));
-  }
-  const gt::Seam& seam = scan.truth.seams[0];
-  {
-    std::ofstream csv(dir / "out" / "trajectory.csv");
-    csv << "idx,x_m,y_m,z_m,qx,qy,qz,qw,rx,ry,rz\n";
-    csv.precision(17);
-    for (std::size_t k = 0; k < seam.root.size(); k += 10) {
-      // Tool z = -normal, x along the seam's direction in the camera frame.
-      const Eigen::Vector3d z = -seam.normal[k];
-      const Eigen::Vector3d x = (seam.root.back() - seam.root.front()).normalized();
-      Eigen::Matrix3d R;
-      R.col(0) = (x - x.dot(z) * z).normalized();
-      R.col(2) = z;
-      R.col(1) = z.cross(R.col(0));
-      const Eigen::Quaterniond q(R);
-      const Eigen::Vector3d& r = seam.root[k];
-      csv << k / 10 << "," << r.x() << "," << r.y() << "," << r.z() << "," << q.x() << "," << q.y()
-          << "," << q.z() << "," << q.w() << ",0,0,0\n";
-    }
-  }
+  write_run(scan, dir / "out", false);
   std::ofstream(dir / "out" / "report.json")
       << R"({"timings_ms": {"features": 10.5, "total": 25.0}})";
 
@@ -311,6 +347,56 @@ TEST(Eval, JointFromTheReport) {
     EXPECT_TRUE(j.at("joint_found").is_null()) << report;
     EXPECT_TRUE(j.at("joint_match").is_null()) << report;
   }
+  std::filesystem::remove_all(dir);
+}
+
+// The tacks a run reports for trajectory.csv's seam (report.json), scored against the
+// renderer's; the path runs from the root's far end, so positions count from there.
+TEST(Eval, TacksFromTheReport) {
+  gt::SynthParams p;
+  p.tacks = 2;
+  p.width = 160;
+  p.height = 120;
+  p.noise = false;
+  const gt::SynthScan scan = gt::render(p);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("gt-evaltacks-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "out");
+  const std::string scan_path = (dir / "scan.pcd").string();
+  gt::write_synth_scan(scan, scan_path);
+  write_run(scan, dir / "out", true);
+  const gt::Seam& seam = scan.truth.seams[0];
+  ASSERT_EQ(seam.tacks.size(), 2u);
+  const double length = seam.length();
+  nlohmann::json tacks = nlohmann::json::array();
+  for (const gt::Tack& t : seam.tacks)  // 1 mm further along the path, 1 mm longer
+    tacks.push_back({{"position_m", length - t.position + 0.001}, {"length_m", t.length + 0.001}});
+  const nlohmann::json report = {
+      {"robust",
+       {{"seams",
+         {{{"file", "trajectory_1.csv"}, {"tacks", nlohmann::json::array()}},
+          {{"file", "trajectory.csv"}, {"joint", "V"}, {"tacks", tacks}}}}}}};
+  std::ofstream(dir / "out" / "report.json") << report.dump();
+  gt::EvalMetrics m = gt::evaluate_files(scan_path, (dir / "out").string());
+  EXPECT_TRUE(m.tacks.reported);
+  EXPECT_EQ(m.tacks.expected, 2u);
+  EXPECT_EQ(m.tacks.found, 2u);
+  EXPECT_EQ(m.tacks.extra, 0u);
+  EXPECT_NEAR(m.tacks.position_mean, 0.001, 1e-6);
+  EXPECT_NEAR(m.tacks.length_bias, 0.001, 1e-9);
+  nlohmann::json j = nlohmann::json::parse(gt::metrics_json(m, scan_path, "out"));
+  EXPECT_EQ(j.at("tacks").at("found"), 2);
+  EXPECT_NEAR(j.at("tacks").at("position_error_max_m").get<double>(), 0.001, 1e-6);
+  EXPECT_NE(gt::metrics_summary(m).find("tacks: 2 of 2 found, 0 extra"), std::string::npos)
+      << gt::metrics_summary(m);
+  // A report without tacks (another method, an older run): expected, not reported.
+  std::ofstream(dir / "out" / "report.json")
+      << R"({"robust": {"seams": [{"file": "trajectory.csv"}]}})";
+  m = gt::evaluate_files(scan_path, (dir / "out").string());
+  j = nlohmann::json::parse(gt::metrics_json(m, scan_path, "out"));
+  EXPECT_FALSE(m.tacks.reported);
+  EXPECT_EQ(j.at("tacks"), nlohmann::json({{"expected", 2}, {"reported", false}}));
+  EXPECT_NE(gt::metrics_summary(m).find("tacks: 2 expected, none reported"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
 

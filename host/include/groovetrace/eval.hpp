@@ -31,6 +31,28 @@ inline std::vector<ToolPose> tool_poses(const Trajectory& trajectory) {
   return poses;
 }
 
+/// A tack weld as a run reports it (report.json robust.seams[k].tacks): its centre's arc
+/// length from the trajectory's first waypoint and its length along the seam (m).
+struct ReportedTack {
+  double position = 0.0;
+  double length = 0.0;
+};
+
+/// The run's tacks against the truth's. A reported tack is placed on its trajectory at its arc
+/// length and measured along the nearest true root line (within coverage_radius of it); it
+/// matches a true tack of that seam when their extents along the root overlap (centres apart by
+/// at most half the sum of their lengths), nearest pairs first, each used once.
+struct TackScore {
+  bool reported = false;     ///< report.json lists tacks (maybe none) for trajectory.csv's seam;
+                             ///< set by evaluate_files
+  std::size_t expected = 0;  ///< true tacks, over every seam
+  std::size_t found = 0;     ///< true tacks matched by a reported one
+  std::size_t extra = 0;     ///< reported tacks matching none
+  double position_mean = 0;  ///< |centre error| along the root over the matches (m); NaN if none
+  double position_max = 0;   ///< m; NaN if none
+  double length_bias = 0;  ///< mean of reported minus true length over the matches (m); NaN if none
+};
+
 struct EvalOptions {
   double coverage_radius = 0.006;  ///< a root point is covered within this of the path (m)
   double coverage_step = 0.0005;   ///< the root line is sampled this finely for coverage (m)
@@ -88,6 +110,10 @@ struct EvalMetrics {
   };
   std::vector<SeamScore> seam_scores;
 
+  /// The first exported seam's tacks (trajectory.csv, report.json) against the truth's
+  /// (evaluate_files; from evaluate: none reported).
+  TackScore tacks;
+
   std::vector<std::string> notes;  ///< caveats (frame, missing files)
 };
 
@@ -104,6 +130,12 @@ GT_API std::vector<EvalMetrics::SeamScore> score_seams(
     const std::vector<std::pair<std::string, std::vector<ToolPose>>>& trajectories,
     const EvalOptions& options = {});
 
+/// The tacks `reported` along `poses` (camera frame, in travel order) against the truth's tacks
+/// (TackScore).
+GT_API TackScore score_tacks(const SynthTruth& truth, const std::vector<ToolPose>& poses,
+                             const std::vector<ReportedTack>& reported,
+                             const EvalOptions& options = {});
+
 /// What evaluate_files reads from a `groovetrace run` output directory.
 struct RunOutput {
   std::uint32_t width = 0, height = 0;  ///< of annotated.pcd
@@ -117,6 +149,9 @@ struct RunOutput {
   double total_ms = 0;           ///< report.json end-to-end time; NaN if absent
   std::vector<std::pair<std::string, double>> stage_ms;  ///< report.json stage timings
   std::string joint;  ///< report.json robust.seams[k].joint of trajectory.csv's seam; "" if none
+  /// report.json robust.seams[k].tacks of trajectory.csv's seam; has_tacks: the key is there.
+  std::vector<ReportedTack> tacks;
+  bool has_tacks = false;
 };
 
 /// Reads annotated.pcd (a PCD of any DATA kind with a `groove` field), trajectory.csv (header

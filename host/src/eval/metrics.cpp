@@ -173,7 +173,92 @@ void score_coverage(const std::vector<Seam>& seams, const std::vector<ToolPose>&
   m.coverage_percent = total > 0.0 ? 100.0 * covered / total : kNaN;
 }
 
+// The point at arc length `s` (m) along the poses' polyline, clamped to its ends.
+Eigen::Vector3d point_at_arc(const std::vector<ToolPose>& poses, double s) {
+  for (std::size_t k = 0; k + 1 < poses.size(); ++k) {
+    const Eigen::Vector3d a = poses[k].position, ab = poses[k + 1].position - a;
+    const double l = ab.norm();
+    if (s <= l && l > 0.0) return a + std::max(s, 0.0) / l * ab;
+    s -= l;
+  }
+  return poses.back().position;
+}
+
+// The arc length (m) along `seam`'s root of its point nearest to q, and that distance.
+double arc_on_seam(const Seam& seam, const Eigen::Vector3d& q, double& distance) {
+  double arc = 0.0, best_arc = 0.0;
+  distance = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k + 1 < seam.root.size(); ++k) {
+    const Eigen::Vector3d a = seam.root[k], ab = seam.root[k + 1] - a;
+    const double l2 = ab.squaredNorm();
+    const double t = l2 > 0.0 ? std::clamp((q - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    const double d = (q - (a + t * ab)).norm();
+    if (d < distance) {
+      distance = d;
+      best_arc = arc + t * std::sqrt(l2);
+    }
+    arc += std::sqrt(l2);
+  }
+  return best_arc;
+}
+
+// A possible pairing of reported tack `r` with true tack `t` of seam `seam`, `apart` (m) along
+// the root.
+struct TackPair {
+  double apart;
+  std::size_t r, seam, t;
+};
+
+std::vector<TackPair> tack_pairs(const SynthTruth& truth, const std::vector<ToolPose>& poses,
+                                 const std::vector<ReportedTack>& reported, double radius) {
+  std::vector<TackPair> pairs;
+  for (std::size_t r = 0; r < reported.size() && !poses.empty(); ++r) {
+    const Eigen::Vector3d q = point_at_arc(poses, reported[r].position);
+    for (std::size_t j = 0; j < truth.seams.size(); ++j) {
+      const Seam& seam = truth.seams[j];
+      double distance = 0.0;
+      const double s = arc_on_seam(seam, q, distance);
+      if (distance > radius) continue;
+      for (std::size_t t = 0; t < seam.tacks.size(); ++t) {
+        double apart = std::abs(s - seam.tacks[t].position);
+        if (seam.closed) apart = std::min(apart, seam.length() - apart);
+        if (apart <= 0.5 * (reported[r].length + seam.tacks[t].length))
+          pairs.push_back({apart, r, j, t});
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end(),
+            [](const TackPair& a, const TackPair& b) { return a.apart < b.apart; });
+  return pairs;
+}
+
 }  // namespace
+
+TackScore score_tacks(const SynthTruth& truth, const std::vector<ToolPose>& poses,
+                      const std::vector<ReportedTack>& reported, const EvalOptions& options) {
+  TackScore score;
+  std::vector<std::vector<bool>> taken;
+  for (const Seam& seam : truth.seams) {
+    score.expected += seam.tacks.size();
+    taken.emplace_back(seam.tacks.size(), false);
+  }
+  std::vector<bool> used(reported.size(), false);
+  double sum = 0.0, max = 0.0, bias = 0.0;
+  for (const TackPair& p : tack_pairs(truth, poses, reported, options.coverage_radius)) {
+    if (used[p.r] || taken[p.seam][p.t]) continue;
+    used[p.r] = taken[p.seam][p.t] = true;
+    ++score.found;
+    sum += p.apart;
+    max = std::max(max, p.apart);
+    bias += reported[p.r].length - truth.seams[p.seam].tacks[p.t].length;
+  }
+  score.extra = reported.size() - score.found;
+  const double n = static_cast<double>(score.found);
+  score.position_mean = score.found > 0 ? sum / n : kNaN;
+  score.position_max = score.found > 0 ? max : kNaN;
+  score.length_bias = score.found > 0 ? bias / n : kNaN;
+  return score;
+}
 
 EvalMetrics evaluate(const SynthTruth& truth, const std::vector<std::uint8_t>& detected,
                      const std::vector<ToolPose>& poses, const EvalOptions& options) {
@@ -225,6 +310,18 @@ nlohmann::json seam_scores_json(const std::vector<EvalMetrics::SeamScore>& score
   return out;
 }
 
+// Without tacks in the run's report (a method or version without them) only the expected count.
+nlohmann::json tacks_json(const TackScore& t) {
+  if (!t.reported) return {{"expected", t.expected}, {"reported", false}};
+  return {{"expected", t.expected},
+          {"reported", true},
+          {"found", t.found},
+          {"extra", t.extra},
+          {"position_error_mean_m", t.position_mean},
+          {"position_error_max_m", t.position_max},
+          {"length_bias_m", t.length_bias}};
+}
+
 }  // namespace
 
 std::string metrics_json(const EvalMetrics& m, const std::string& truth,
@@ -271,10 +368,30 @@ std::string metrics_json(const EvalMetrics& m, const std::string& truth,
       {"joint_match",
        m.joint_found.empty() ? json(nullptr) : json(m.joint_found == m.joint_expected)},
       {"seams", seam_scores_json(m.seam_scores)},
+      {"tacks", tacks_json(m.tacks)},
       {"notes", m.notes},
   };
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
+
+namespace {
+
+std::string tacks_summary(const TackScore& t) {
+  if (!t.reported) return "tacks: " + std::to_string(t.expected) + " expected, none reported\n";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "tacks: %zu of %zu found, %zu extra", t.found, t.expected,
+                t.extra);
+  std::string s = buf;
+  if (t.found > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "; position error mean %.1f mm, max %.1f mm; length bias %+.1f mm",
+                  t.position_mean * 1e3, t.position_max * 1e3, t.length_bias * 1e3);
+    s += buf;
+  }
+  return s + "\n";
+}
+
+}  // namespace
 
 std::string metrics_summary(const EvalMetrics& m) {
   char buf[512];
@@ -320,6 +437,7 @@ std::string metrics_summary(const EvalMetrics& m) {
                   seam.depth_mean * 1e3, seam.tool_axis_mean_deg, seam.coverage_percent);
     s += buf;
   }
+  if (m.tacks.reported || m.tacks.expected > 0) s += tacks_summary(m.tacks);
   for (const std::string& note : m.notes) s += "note: " + note + "\n";
   return s;
 }

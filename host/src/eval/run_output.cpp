@@ -126,9 +126,10 @@ void read_report(const nlohmann::json& j, RunOutput& out) {
   }
 }
 
-// The joint the detector reports for the first exported seam: the robust.seams entry whose
-// "file" is "trajectory.csv".
-void read_report_joint(const nlohmann::json& j, RunOutput& out) {
+// The joint and tacks the detector reports for the first exported seam: the robust.seams
+// entry whose "file" is "trajectory.csv". Tacks without a finite position and length are
+// skipped.
+void read_report_seam(const nlohmann::json& j, RunOutput& out) {
   if (!j.is_object() || !j.contains("robust") || !j["robust"].is_object()) return;
   const nlohmann::json& robust = j["robust"];
   if (!robust.contains("seams") || !robust["seams"].is_array()) return;
@@ -136,6 +137,14 @@ void read_report_joint(const nlohmann::json& j, RunOutput& out) {
     if (!seam.is_object() || !seam.contains("file") || seam["file"] != "trajectory.csv") continue;
     if (seam.contains("joint") && seam["joint"].is_string())
       out.joint = seam["joint"].get<std::string>();
+    if (!seam.contains("tacks") || !seam["tacks"].is_array()) return;
+    out.has_tacks = true;
+    for (const nlohmann::json& t : seam["tacks"]) {
+      if (!t.is_object() || !t.contains("position_m") || !t["position_m"].is_number() ||
+          !t.contains("length_m") || !t["length_m"].is_number())
+        continue;
+      out.tacks.push_back({t["position_m"].get<double>(), t["length_m"].get<double>()});
+    }
     return;
   }
 }
@@ -168,7 +177,7 @@ RunOutput read_run_output(const std::string& result_dir) {
     const nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
     if (!j.is_discarded()) {
       read_report(j, out);
-      read_report_joint(j, out);
+      read_report_seam(j, out);
     }
   }
   return out;
@@ -201,6 +210,8 @@ EvalMetrics evaluate_files(const std::string& scan_path, const std::string& resu
   m.stage_ms = run.stage_ms;
   m.joint_found = run.joint;
   m.seam_scores = score_seams(truth, run.trajectories, options);
+  m.tacks = score_tacks(truth, run.poses, run.tacks, options);
+  m.tacks.reported = run.has_tacks;
   return m;
 }
 
