@@ -256,6 +256,26 @@ TEST(RobustDetect, ShallowGirthGrooveIsFoundBySecondSearch) {
   EXPECT_FALSE(first.retried);
 }
 
+// A noise-free scan (no blur fills the slot): a 6 mm, 50 deg V with the renderer's 0.5 mm root
+// gap, 640x480 at 0.45 m, 5 deg off square. Rays through the slot meet the table 10 mm under
+// the root faces; the first V seeded there overhangs, and no groove was found (exit 4).
+TEST(RobustDetect, CleanScanWithTheTableSeenThroughTheGap) {
+  SynthParams sp = vga_joint(316);
+  sp.groove_width = 0.006;
+  sp.groove_angle_deg = 50;
+  sp.distance = 0.45;
+  sp.tilt_deg = 5;
+  sp.noise = false;
+  const JointRun run(sp);
+  ASSERT_GE(accepted_count(run.det), 1u);
+  const SeamCandidate& seam = *best_accepted(run.det);
+  const auto [dist, angle] = run.errors(seam);
+  EXPECT_LT(dist, 0.0006);  // the gap reads a pixel wide: the root sits up to 0.5 mm high
+  EXPECT_LT(angle, 1.0);
+  EXPECT_GT(seam.length, 0.29);
+  EXPECT_GT(seam.gap, 0.0);
+}
+
 // Near a plate's end a section's ball reaches over the end face and the stereo blur along
 // it, and the fits fail: the path of this bevel stopped 3.8 and 7.7 mm short of the plate's
 // ends (a 300 mm seam). Past its last fit the seam continues while a thin slab there still

@@ -782,6 +782,49 @@ double root_gap(const VModel& m, const ProfileFit& f, double band, double depth,
   return covered / slant;
 }
 
+// Steps 3 and 4: the V from the groove's run, refined free, then tied as `tie` where that
+// fit converges. False, `m` unusable, when the free fit diverges.
+bool refine_from(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q,
+                 const ProfileFit& f, Tie tie, VModel& m) {
+  m = initial_v(groove, q, f);
+  if (!refine_v(f.pts, m, f.scale, f.vertex_zone, 0.1 * f.W, Tie::free)) return false;
+  if (tie == Tie::free) return true;
+  VModel tied = m;
+  if (tie != Tie::symmetric) {  // the square side's edge straight above the root
+    (tie == Tie::square_left ? tied.u_left : tied.u_right) =
+        tied.root.x() + (tie == Tie::square_left ? -1 : 1) * VParams::kHair;
+  }
+  if (refine_v(f.pts, tied, f.scale, f.vertex_zone, 0.1 * f.W, tie)) m = tied;
+  return true;
+}
+
+// A root gap seen straight through shows the table (a plate's thickness below the root
+// faces) in a strip under the slot. Where few rays blur it, that strip holds the run's deepest
+// tenth of points and the first V is seeded on the table, its walls overhanging (a clean
+// 6 mm 50 deg V with a 0.5 mm gap at 0.45 m, 5 deg off square: no section passed). So when the
+// first V fails, the run is seeded again without the points within the widest half gap of
+// its deepest one; the refit sees every point and the Tukey weights leave the strip out.
+// Returns the better judgement, `m` the model it belongs to.
+VProfile past_the_slot(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q,
+                       const ProfileFit& f, Tie tie, VModel& m, const VProfile& failed) {
+  std::size_t deepest = 0;
+  for (std::size_t k = 1; k < groove.size(); ++k) {
+    if (groove[k].y() - f.top(q, groove[k].x()) <
+        groove[deepest].y() - f.top(q, groove[deepest].x()))
+      deepest = k;
+  }
+  std::vector<Eigen::Vector2d> rest;
+  for (const auto& p : groove) {
+    if (std::abs(p.x() - groove[deepest].x()) > kMaxHalfGap) rest.push_back(p);
+  }
+  VModel again;
+  if (rest.size() < 6 || !refine_from(rest, q, f, tie, again)) return failed;
+  const VProfile judged = judge_v(again, false, f);
+  if (!judged.ok) return failed;
+  m = again;
+  return judged;
+}
+
 // The two-wall V `two_wall` (model `m`, fitted tied by `tie`) with its root gap measured. On
 // a seam with a gap (`refit_seam`), the slot's points drag the walls' fit down towards them (2 mm
 // of table seen 3 mm below the root faces moved the root 0.5 mm), so the V is refitted
@@ -827,31 +870,23 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
   out.noise = f.sigma;
   const std::vector<Eigen::Vector2d> groove = groove_run(f, q, out.why);
   if (groove.empty()) return out;
-  VModel m = initial_v(groove, q, f);
-
   // 4. Joint robust fit of the whole V (root, both edges, the top's offset and slope) to the
   //    orthogonal distances, by Gauss-Newton with Tukey weights. Points near the three
   //    vertices do not count: rounded rims and the root gap are not the V's planes.
   f.scale = std::max(f.sigma, 0.005 * f.W);
   f.vertex_zone = std::max(2 * f.sigma, 0.06 * f.W);
-  if (!refine_v(f.pts, m, f.scale, f.vertex_zone, 0.1 * f.W, Tie::free)) {
-    out.why = "V fit did not converge";
-    return out;
-  }
   const Tie tie = mode.stepped      ? Tie::free
                   : mode.symmetric  ? Tie::symmetric
                   : mode.square < 0 ? Tie::square_left
                   : mode.square > 0 ? Tie::square_right
                                     : Tie::free;
-  if (tie != Tie::free) {
-    VModel tied = m;
-    if (tie != Tie::symmetric) {  // the square side's edge straight above the root
-      (tie == Tie::square_left ? tied.u_left : tied.u_right) =
-          tied.root.x() + (tie == Tie::square_left ? -1 : 1) * VParams::kHair;
-    }
-    if (refine_v(f.pts, tied, f.scale, f.vertex_zone, 0.1 * f.W, tie)) m = tied;
+  VModel m;
+  if (!refine_from(groove, q, f, tie, m)) {
+    out.why = "V fit did not converge";
+    return out;
   }
-  const VProfile two_wall = judge_v(m, false, f);
+  VProfile two_wall = judge_v(m, false, f);
+  if (!two_wall.ok) two_wall = past_the_slot(groove, q, f, tie, m, two_wall);
   if (two_wall.ok) return with_root_gap(m, f, tie, two_wall, mode.root_gap);
   return one_wall_v(m, two_wall, f, groove, mode);
 }
