@@ -799,26 +799,37 @@ bool refine_from(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector
 }
 
 // A root gap seen straight through shows the table (a plate's thickness below the root
-// faces) in a strip under the slot. Where few rays blur it, that strip holds the run's deepest
+// faces) in a strip under the slot. Where no blur fills it, that strip holds the run's deepest
 // tenth of points and the first V is seeded on the table, its walls overhanging (a clean
-// 6 mm 50 deg V with a 0.5 mm gap at 0.45 m, 5 deg off square: no section passed). So when the
-// first V fails, the run is seeded again without the points within the widest half gap of
-// its deepest one; the refit sees every point and the Tukey weights leave the strip out.
-// Returns the better judgement, `m` the model it belongs to.
+// 6 mm 50 deg V with a 0.5 mm gap at 0.45 m, 5 deg off square: no section passed, exit 4).
+// So when the first V overhangs and the run's deepest point lies below every point beyond
+// the widest half gap from it by more than kMinSlotJump noise bands, the run is seeded again
+// without those points; the refit sees every point and the Tukey weights leave the strip out.
+// There the strip lay 14-19 bands deeper; in the sweep's noisy scans the deepest points of
+// overhanging V's lie within 2 (seeding every overhanging V again moved 8 of its 131 scans,
+// 6 for the worse: a clamp's or a shadow's edge taken for a wall). Returns the judgement,
+// `m` its model.
+constexpr double kMinSlotJump = 4.0;
+
 VProfile past_the_slot(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector3d& q,
                        const ProfileFit& f, Tie tie, VModel& m, const VProfile& failed) {
+  if (failed.why != "a wall overhangs") return failed;
+  const auto depth = [&](const Eigen::Vector2d& p) { return f.top(q, p.x()) - p.y(); };
   std::size_t deepest = 0;
   for (std::size_t k = 1; k < groove.size(); ++k) {
-    if (groove[k].y() - f.top(q, groove[k].x()) <
-        groove[deepest].y() - f.top(q, groove[deepest].x()))
-      deepest = k;
+    if (depth(groove[k]) > depth(groove[deepest])) deepest = k;
   }
   std::vector<Eigen::Vector2d> rest;
+  double rest_depth = 0;
   for (const auto& p : groove) {
-    if (std::abs(p.x() - groove[deepest].x()) > kMaxHalfGap) rest.push_back(p);
+    if (std::abs(p.x() - groove[deepest].x()) <= kMaxHalfGap) continue;
+    rest.push_back(p);
+    rest_depth = std::max(rest_depth, depth(p));
   }
   VModel again;
-  if (rest.size() < 6 || !refine_from(rest, q, f, tie, again)) return failed;
+  if (rest.size() < 6 || depth(groove[deepest]) - rest_depth < kMinSlotJump * f.tau ||
+      !refine_from(rest, q, f, tie, again))
+    return failed;
   const VProfile judged = judge_v(again, false, f);
   if (!judged.ok) return failed;
   m = again;
