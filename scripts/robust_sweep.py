@@ -774,7 +774,9 @@ def joint_run(binary, out_root, spec):
         rec["problems"] = check_trajectory(os.path.join(out, "trajectory.csv"))[0]
         rec["scale_m"] = seam_report(out).get("scale_m")
     with open(scan[:-4] + ".truth.json") as f:
-        rec["joint_expected"] = json.load(f)["seams"][0].get("joint", "V")
+        truth = json.load(f)
+    rec["joint_expected"] = truth["seams"][0].get("joint", "V")
+    rec["tacks_expected"] = sum(len(s.get("tacks", [])) for s in truth["seams"])
     m = rec.get("metrics") or {}
     log(f"{spec['scan']:44s} rc {rec['rc']} IoU {fmt(m.get('iou_percent'))} "
         f"lat {fmt((m.get('lateral_mean_m') or float('nan')) * 1e3)} "
@@ -1025,10 +1027,10 @@ def tack_rows(records):
          "|---|---:|---:|---:|---:|"]
     for r in records:
         t = (r.get("metrics") or {}).get("tacks") or {}
-        if r.get("expect") != "joint" or not t.get("expected"):
+        if r.get("expect") != "joint" or not r.get("tacks_expected"):
             continue
         if r["rc"] != 0 or not t.get("reported"):
-            L.append(f"| {r['scan']} | - / {t.get('expected', '-')} | - | - | - |")
+            L.append(f"| {r['scan']} | - / {r['tacks_expected']} | - | - | - |")
             continue
         mm = lambda k: fmt((t.get(k) if t.get(k) is not None else float("nan")) * 1e3, 1)
         L.append(f"| {r['scan']} | {t['found']} / {t['expected']} | {t['extra']} | "

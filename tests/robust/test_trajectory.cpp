@@ -96,6 +96,58 @@ TEST(RobustTrajectory, ClosedSeamReturnsToItsStart) {
   EXPECT_NEAR(t.waypoints.front().position.x(), -0.04, 1e-4);
 }
 
+// The arc length along the trajectory of its waypoint nearest to p (m).
+double path_arc_at(const Trajectory& t, const Eigen::Vector3d& p) {
+  double arc = 0, best_arc = 0, best = INFINITY;
+  for (std::size_t k = 0; k < t.waypoints.size(); ++k) {
+    if (k > 0) arc += (t.waypoints[k].position - t.waypoints[k - 1].position).norm();
+    const double d = (t.waypoints[k].position - p).norm();
+    if (d < best) {
+      best = d;
+      best_arc = arc;
+    }
+  }
+  return best_arc;
+}
+
+// report.json counts stations and tacks along the path (travel_arc): an open seam traced
+// against the travel and a ring whose sections run clockwise about its normal (the path runs
+// the other way) from a point that is not its path's start both map onto the waypoints' arc length,
+// within the 2 mm step.
+TEST(RobustTrajectory, TravelArcCountsAlongThePath) {
+  SeamCandidate open = quarter_circle();
+  for (std::size_t k = 0; k < open.sections.size(); ++k) open.sections[k].s = 0.05 * M_PI / 200 * k;
+  const Trajectory t_open = seam_trajectory(open, RobustParams{});
+  for (std::size_t k = 0; k < open.sections.size(); k += 10) {
+    const GrooveSection& g = open.sections[k];
+    EXPECT_NEAR(travel_arc(open, g.s), path_arc_at(t_open, g.root), 0.0011) << k;
+  }
+  SeamCandidate ring;
+  const double radius = 0.04, length = 2 * M_PI * radius;
+  for (int k = 0; k < 200; ++k) {
+    const double a = 1.0 + 2 * M_PI * k / 200;  // from 1 rad, clockwise about the normal
+    GrooveSection g;
+    g.ok = true;
+    g.root = Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), 0.4);
+    g.tangent = Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
+    g.s = length * k / 200;
+    ring.sections.push_back(g);
+  }
+  ring.closed = ring.curve.closed = true;
+  ring.curve.length = ring.length = length;
+  ring.accepted = true;
+  const Trajectory t_ring = seam_trajectory(ring, RobustParams{});
+  for (int k = 0; k < 200; k += 10) {
+    const GrooveSection& g = ring.sections[k];
+    const double along = travel_arc(ring, g.s);
+    EXPECT_GE(along, 0.0);
+    EXPECT_LT(along, length);
+    const double d = std::abs(along - path_arc_at(t_ring, g.root));
+    EXPECT_LT(std::min(d, length - d), 0.0011) << k;
+  }
+}
+
 // An L: 60 mm along +x, a 90 deg corner at the origin, 60 mm along +y; sections every 1.5 mm,
 // the bisector tilted 10 deg across the first leg. Tangent signs carry no meaning.
 SeamCandidate l_corner() {

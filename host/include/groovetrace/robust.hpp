@@ -115,9 +115,11 @@ struct SeamCandidate {
 /// normal and ends where it started.
 GT_API Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params);
 
-/// Whether seam_trajectory runs the open `seam` from its last section to its first: a path
-/// travels towards larger x of the cloud's frame (ties: y, then z). False for a closed seam.
-GT_API bool travels_backwards(const SeamCandidate& seam);
+/// Arc length (m) along seam_trajectory's path of the point of `seam` at arc length `s` of its
+/// sections (GrooveSection::s): an open seam's path may run from its last section to its
+/// first, a ring's starts at its section of smallest x and may run against their order (then
+/// modulo the ring's length, in [0, length)).
+GT_API double travel_arc(const SeamCandidate& seam, double s);
 
 /// What the search at one scale found (RobustParams::scales).
 struct ScaleSearchSummary {

@@ -12,14 +12,20 @@ namespace {
 
 // A ring starts at its smallest x (ties: y) and runs counter-clockwise about its mean surface
 // normal.
-void orient_ring(std::vector<GrooveSection>& secs) {
+// Where a ring's path starts - its section of smallest x (ties: y) - and whether it runs
+// against the sections' order: counter-clockwise about the mean top normal.
+struct RingStart {
   std::size_t first = 0;
+  bool reversed = false;
+};
+
+RingStart ring_start(const std::vector<GrooveSection>& secs) {
+  RingStart start;
   for (std::size_t k = 1; k < secs.size(); ++k) {
     const Eigen::Vector3d& a = secs[k].root;
-    const Eigen::Vector3d& b = secs[first].root;
-    if (a.x() < b.x() || (a.x() == b.x() && a.y() < b.y())) first = k;
+    const Eigen::Vector3d& b = secs[start.first].root;
+    if (a.x() < b.x() || (a.x() == b.x() && a.y() < b.y())) start.first = k;
   }
-  std::rotate(secs.begin(), secs.begin() + static_cast<std::ptrdiff_t>(first), secs.end());
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
   for (const auto& s : secs) {
     centre += s.root;
@@ -30,7 +36,14 @@ void orient_ring(std::vector<GrooveSection>& secs) {
   for (std::size_t k = 0; k < secs.size(); ++k) {
     turn += (secs[k].root - centre).cross(secs[(k + 1) % secs.size()].root - centre);
   }
-  if (turn.dot(up) < 0) std::reverse(secs.begin() + 1, secs.end());
+  start.reversed = turn.dot(up) < 0;
+  return start;
+}
+
+void orient_ring(std::vector<GrooveSection>& secs) {
+  const RingStart start = ring_start(secs);
+  std::rotate(secs.begin(), secs.begin() + static_cast<std::ptrdiff_t>(start.first), secs.end());
+  if (start.reversed) std::reverse(secs.begin() + 1, secs.end());
 }
 
 // Whether an open seam from `first` to `last` (roots, m) runs towards smaller x (ties: y, then z).
@@ -236,9 +249,16 @@ Waypoint waypoint_at(const TorchPath& path, std::size_t seg, double f,
 
 }  // namespace
 
-bool travels_backwards(const SeamCandidate& seam) {
+double travel_arc(const SeamCandidate& seam, double s) {
   const auto& secs = seam.sections;
-  return !seam.closed && !secs.empty() && backwards(secs.front().root, secs.back().root);
+  if (secs.empty()) return s;
+  if (!seam.closed) {
+    return backwards(secs.front().root, secs.back().root) ? secs.front().s + secs.back().s - s : s;
+  }
+  const RingStart start = ring_start(secs);
+  const double ring = seam.curve.length > 0 ? seam.curve.length : seam.length;
+  const double d = (start.reversed ? -1.0 : 1.0) * (s - secs[start.first].s);
+  return ring > 0 ? d - ring * std::floor(d / ring) : d;
 }
 
 Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params) {

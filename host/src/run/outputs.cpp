@@ -25,22 +25,18 @@ using nlohmann::json;
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-// Arc length `s` (m) of `seam` counted as its trajectory runs (travels_backwards: from its last
-// section).
-double along_travel(const SeamCandidate& seam, double s) {
-  if (!travels_backwards(seam)) return s;
-  return seam.sections.front().s + seam.sections.back().s - s;
-}
-
 // The fitted cross-section at every station of a seam, in the trajectory's order
-// (docs/method-robust.md, "Score"): arc length and root (m, the cloud's frame), opening width,
-// depth, included angle, high-low, and how the station was fitted.
+// (docs/method-robust.md, "Score"): arc length along the path and root (m, the cloud's frame),
+// opening width, depth, included angle, high-low, and how the station was fitted.
 json stations_json(const SeamCandidate& seam) {
   auto num = finite_or_null;
+  std::vector<std::pair<double, const GrooveSection*>> order;
+  for (const GrooveSection& s : seam.sections) order.emplace_back(travel_arc(seam, s.s), &s);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
   json out = json::array();
-  std::vector<GrooveSection> secs = seam.sections;
-  if (travels_backwards(seam)) std::reverse(secs.begin(), secs.end());
-  for (const GrooveSection& s : secs) {
+  for (const auto& [along, sec] : order) {
+    const GrooveSection& s = *sec;
     const char* fit = !s.ok        ? (s.inferred   ? "inferred"
                                       : s.extended ? "extended"
                                                    : "none")
@@ -48,7 +44,7 @@ json stations_json(const SeamCandidate& seam) {
                       : s.one_wall ? "one_wall"
                                    : "v";
     out.push_back(
-        {{"s_m", num(along_travel(seam, s.s))},
+        {{"s_m", num(along)},
          {"root_m", {num(s.root.x()), num(s.root.y()), num(s.root.z())}},
          {"opening_m", num(s.width)},
          {"depth_m", num(s.depth)},
@@ -62,13 +58,15 @@ json stations_json(const SeamCandidate& seam) {
 }
 
 // The tack welds found along a seam, in the trajectory's order: arc length of each one's centre
-// (as the stations') and its length (m).
+// along the path (as the stations') and its length (m).
 json tacks_json(const SeamCandidate& seam) {
-  json out = json::array();
+  std::vector<std::pair<double, double>> tacks;  // (along the path, length)
   for (const SeamCandidate::Tack& t : seam.tacks)
-    out.push_back({{"position_m", finite_or_null(along_travel(seam, t.position))},
-                   {"length_m", finite_or_null(t.length)}});
-  if (travels_backwards(seam)) std::reverse(out.begin(), out.end());
+    tacks.emplace_back(travel_arc(seam, t.position), t.length);
+  std::sort(tacks.begin(), tacks.end());
+  json out = json::array();
+  for (const auto& [along, length] : tacks)
+    out.push_back({{"position_m", finite_or_null(along)}, {"length_m", finite_or_null(length)}});
   return out;
 }
 
