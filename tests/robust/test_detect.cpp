@@ -416,6 +416,7 @@ TEST(RobustDetect, TacksAreReportedAndThePathStaysOnTheRoot) {
   ASSERT_EQ(s.tacks.size(), 3u);
   // The seam may run either way along the truth's root line: compare each found tack's centre
   // with the nearest true centre, through the root at its arc length.
+  double bias = 0;  // mean found minus true length (m): the runs' flanks count
   for (const SeamCandidate::Tack& t : s.tacks) {
     std::size_t k = 0;
     while (k + 1 < s.sections.size() && s.sections[k + 1].s <= t.position) ++k;
@@ -429,8 +430,10 @@ TEST(RobustDetect, TacksAreReportedAndThePathStaysOnTheRoot) {
       }
     }
     EXPECT_LT(best, 0.005);
-    EXPECT_NEAR(t.length, length, 0.006);
+    EXPECT_NEAR(t.length, length, 0.004) << "at " << t.position;
+    bias += (t.length - length) / 3;
   }
+  EXPECT_NEAR(bias, 0.0, 0.002);  // 3.5-4.3 mm short with the filled middles alone
   EXPECT_LT(run.errors(s).first, 0.0008);
 }
 
