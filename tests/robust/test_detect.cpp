@@ -217,6 +217,16 @@ SynthParams vga_joint(std::uint64_t seed) {
   return sp;
 }
 
+// The sweep's v6-50 scene s316: a 6 mm, 50 deg V at 0.45 m, 640x480, 5 deg off square.
+SynthParams v6_50_s316() {
+  SynthParams sp = vga_joint(316);
+  sp.groove_width = 0.006;
+  sp.groove_angle_deg = 50;
+  sp.distance = 0.45;
+  sp.tilt_deg = 5;
+  return sp;
+}
+
 // A joint rendered from `sp` and the default robust run on it.
 struct JointRun {
   explicit JointRun(const SynthParams& sp) : scan(render(sp)), det(detect_robust(scan.cloud, {})) {}
@@ -260,11 +270,7 @@ TEST(RobustDetect, ShallowGirthGrooveIsFoundBySecondSearch) {
 // gap, 640x480 at 0.45 m, 5 deg off square. Rays through the slot meet the table 10 mm under
 // the root faces; the first V seeded there overhangs, and no groove was found (exit 4).
 TEST(RobustDetect, CleanScanWithTheTableSeenThroughTheGap) {
-  SynthParams sp = vga_joint(316);
-  sp.groove_width = 0.006;
-  sp.groove_angle_deg = 50;
-  sp.distance = 0.45;
-  sp.tilt_deg = 5;
+  SynthParams sp = v6_50_s316();
   sp.noise = false;
   const JointRun run(sp);
   ASSERT_GE(accepted_count(run.det), 1u);
@@ -518,12 +524,7 @@ TEST(RobustDetect, NarrowVSeenAtASlantKeepsTheTorchOnItsBisector) {
 // only over 152 mm at 5 mm, and the finer reading, ranked first, pushed the whole one out as
 // its repeat (robust/merge.cpp, reads_further).
 TEST(RobustDetect, NarrowGrooveIsKeptAtTheScaleThatReadsItWhole) {
-  SynthParams sp = vga_joint(316);
-  sp.groove_width = 0.006;
-  sp.groove_angle_deg = 50;
-  sp.distance = 0.45;
-  sp.tilt_deg = 5;
-  const JointRun run(sp);
+  const JointRun run(v6_50_s316());
   ASSERT_GT(accepted_count(run.det), 0u);
   const SeamCandidate& s = *best_accepted(run.det);
   EXPECT_GT(s.length, 0.25);
