@@ -58,8 +58,9 @@ struct RobustParams {
   /// Half-window of the smoothing along the seam (m): the seam's curve and roots over it, the
   /// groove's shape over 5 times it. At scales beyond 20 mm, 0.3 times the scale.
   double smooth = 0.006;
-  /// Half-window of the torch path's smoothing in depth, along the top normal (m;
-  /// docs/method-robust.md, "Trajectory").
+  /// Half-window of the torch path's smoothing in depth, along the top normal (m): the top
+  /// above the roots over it, a groove's depth below the top over 3 times it
+  /// (docs/method-robust.md, "Trajectory").
   double depth_smooth = 0.024;
   double min_length = 0.015;  ///< seams shorter than this are rejected (m)
   double step = 0.002;        ///< waypoint spacing along the seam (m)

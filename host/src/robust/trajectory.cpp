@@ -87,6 +87,7 @@ void drop_folds(std::vector<GrooveSection>& secs, bool closed) {
 struct TorchPath {
   std::vector<Eigen::Vector3d> P, B, T, N;  ///< N: the top surface normal
   std::vector<double> S;
+  std::vector<double> D;  ///< the groove's depth, root below the top along N (m)
 };
 
 // The root `reach` (m) or more before (dir = -1) or after (+1) root k along the path (rings
@@ -114,6 +115,7 @@ TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
     path.P.push_back(secs[k].root);
     path.B.push_back(secs[k].bisector);
     path.N.push_back(secs[k].normal);
+    path.D.push_back(secs[k].depth);
     const std::size_t next = root_at_reach(secs, k, +1, closed, kSignReach);
     const std::size_t prev = root_at_reach(secs, k, -1, closed, kSignReach);
     Eigen::Vector3d t = secs[k].tangent;
@@ -125,6 +127,7 @@ TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
     path.B.push_back(path.B.front());
     path.T.push_back(path.T.front());
     path.N.push_back(path.N.front());
+    path.D.push_back(path.D.front());
   }
   path.S.assign(path.P.size(), 0.0);
   for (std::size_t k = 1; k < path.P.size(); ++k) {
@@ -191,35 +194,74 @@ void blend_orientation(TorchPath& path, double blend, bool closed) {
   }
 }
 
-// The roots' height along the top normal smoothed over `half` (m) of arc length either side:
-// at each root a tricube-weighted quadratic in arc length through the neighbours' heights
-// above it, taken at the root (a quadratic follows a pipe's curvature; the window shrinks to
-// stay centred near an open path's ends, so they are not smoothed). The sections' roots are
-// smoothed over +-6 mm, across and in depth alike; in depth a D415's noise (about 1 mm per
-// pixel at 640x480) and undulation left the path 1-6 mm up and down on a flat straight seam.
-// Smoothing the sections' depth offsets over +-18 mm instead moved too much else (a seam's
-// fits and labels; an L on a far 640x480 scan split in two): here only the path moves.
-void smooth_depth(TorchPath& path, double half, bool closed) {
-  const std::size_t n = closed ? path.P.size() - 1 : path.P.size();
+// The arc-length offset (m) from root k to root j (rings wrap), and the half-window (m) about
+// root k: `half`, shrunk near an open path's ends to stay centred.
+double arc_offset(const TorchPath& path, std::size_t k, std::size_t j, bool closed) {
   const double L = path.S.back();
+  double d = path.S[j] - path.S[k];
+  if (closed) d -= L * std::round(d / L);
+  return d;
+}
+
+double centred_half(const TorchPath& path, std::size_t k, double half, bool closed) {
+  const double L = path.S.back();
+  return closed ? half : std::min(half, std::min(path.S[k], L - path.S[k]));
+}
+
+double tricube(double d, double h) {
+  const double u = h > 0 ? std::abs(d) / h : 0.0;
+  return std::pow(1 - u * u * u, 3);
+}
+
+// The groove's depth at root k: the tricube-weighted mean of the roots' depths over `half`
+// (m) of arc length either side, centred.
+double mean_depth(const TorchPath& path, std::size_t k, double half, bool closed, std::size_t n) {
+  const double h = centred_half(path, k, half, closed);
+  double sw = 0, sd = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double d = arc_offset(path, k, j, closed);
+    if (std::abs(d) >= h && j != k) continue;
+    sw += tricube(d, h);
+    sd += tricube(d, h) * path.D[j];
+  }
+  return sw > 0 ? sd / sw : path.D[k];
+}
+
+// The roots' height along the top normal, smoothed. The top above each root (root + depth
+// along the normal) is smoothed over `half` (m) of arc length either side: at each root a
+// tricube-weighted quadratic in arc length through the neighbours' tops, taken at the root (a
+// quadratic follows a pipe's curvature; the window shrinks to stay centred near an open
+// path's ends, so they are not smoothed). The groove's depth is taken off that, smoothed over
+// kDepthWindow times as much: a groove's depth changes slowly along its seam, and its root,
+// where two steep walls fitted to a few image rows each meet, scatters in depth by 1-3 mm at
+// 640x480 where the top beside it, fitted to the wide top surfaces, moves by about 1 mm (the
+// sweep's v16-90 s319: the path's depth error 1.34 mm rms with the roots smoothed alone, in
+// 40-60 mm waves; 0.89 mm now). A corner joint's depth is its weld's throat, not a groove's:
+// there the roots' own heights are smoothed. Only the path moves: the sections (and with
+// them the region and the reported stations) keep their roots.
+constexpr double kDepthWindow = 3.0;
+
+void smooth_depth(TorchPath& path, double half, bool closed, bool corner) {
+  const std::size_t n = closed ? path.P.size() - 1 : path.P.size();
   if (n < 5) return;
   std::vector<double> lift(n, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
-    const double h = closed ? half : std::min(half, std::min(path.S[k], L - path.S[k]));
+    const double h = centred_half(path, k, half, closed);
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (std::size_t j = 0; j < n; ++j) {
-      double d = path.S[j] - path.S[k];
-      if (closed) d -= L * std::round(d / L);
+      const double d = arc_offset(path, k, j, closed);
       if (std::abs(d) >= h && j != k) continue;
-      const double u = h > 0 ? std::abs(d) / h : 0.0;
-      const double w = std::pow(1 - u * u * u, 3);
       const Eigen::Vector3d x(1, d, d * d);
-      A += w * x * x.transpose();
-      b += w * x * (path.P[j] - path.P[k]).dot(path.N[k]);
+      const double top = (path.P[j] - path.P[k]).dot(path.N[k]) + (corner ? 0.0 : path.D[j]);
+      A += tricube(d, h) * x * x.transpose();
+      b += tricube(d, h) * x * top;
     }
     const Eigen::Vector3d c = A.ldlt().solve(b);
-    if (A(2, 2) > 1e-12 * A(0, 0) && c.allFinite()) lift[k] = c[0];
+    const double depth = corner ? 0.0 : mean_depth(path, k, kDepthWindow * half, closed, n);
+    lift[k] = A(2, 2) > 1e-12 * A(0, 0) && c.allFinite() ? c[0] - depth
+              : corner                                   ? 0.0
+                                                         : path.D[k] - depth;
   }
   for (std::size_t k = 0; k < n; ++k) path.P[k] += lift[k] * path.N[k];
   if (closed) path.P[n] = path.P[0];
@@ -272,7 +314,7 @@ Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params
   }
   drop_folds(secs, closed);
   TorchPath path = torch_path(secs, closed);
-  smooth_depth(path, params.depth_smooth, closed);
+  smooth_depth(path, params.depth_smooth, closed, seam.corner);
   blend_orientation(path, params.orientation_blend, closed);
   const std::vector<Eigen::Vector3d>& P = path.P;
   const std::vector<double>& S = path.S;
