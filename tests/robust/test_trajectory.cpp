@@ -266,21 +266,32 @@ TEST(RobustTrajectory, ACornerThatFoldsBackIsCut) {
   EXPECT_NEAR(sharp.length, 2 * 0.0585 + std::hypot(0.0005, 0.0015), 1e-9);
 }
 
-// A flat straight seam whose roots wave up and down by +-0.5 mm (period 15 mm, a D415's
-// undulation) comes out within +-0.1 mm; the waves across the seam stay (the path follows the
-// sections across), and RobustParams::depth_smooth = 0 leaves the depth alone.
-TEST(RobustTrajectory, DepthIsSmoothedAlongAFlatSeam) {
+// A straight seam along x (-150..150 mm every 1.5 mm), tool down the -z normal: each root at
+// (x, across(x), 0.4 + up(x)) m, `depth(x)` m below the top.
+template <class Across, class Up, class Depth>
+SeamCandidate straight_seam(Across across, Up up, Depth depth) {
   SeamCandidate s;
   for (int k = 0; k <= 200; ++k) {
     GrooveSection g;
     g.ok = true;
-    const double x = -0.15 + 0.0015 * k, wave = 0.0005 * std::sin(2 * M_PI * x / 0.015);
-    g.root = Eigen::Vector3d(x, 0.2 * wave, 0.4 + wave);
+    const double x = -0.15 + 0.0015 * k;
+    g.root = Eigen::Vector3d(x, across(x), 0.4 + up(x));
+    g.depth = depth(x);
     g.tangent = Eigen::Vector3d(1, 0, 0);
     g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
     s.sections.push_back(g);
   }
   s.accepted = true;
+  return s;
+}
+
+// A flat straight seam whose roots wave up and down by +-0.5 mm (period 15 mm, a D415's
+// undulation) comes out within +-0.1 mm; the waves across the seam stay (the path follows the
+// sections across), and RobustParams::depth_smooth = 0 leaves the depth alone.
+TEST(RobustTrajectory, DepthIsSmoothedAlongAFlatSeam) {
+  const auto wave = [](double x) { return 0.0005 * std::sin(2 * M_PI * x / 0.015); };
+  const SeamCandidate s =
+      straight_seam([&](double x) { return 0.2 * wave(x); }, wave, [](double) { return 0.0; });
   RobustParams p;
   double inner = 0, across = 0, raw = 0;
   for (const Waypoint& w : seam_trajectory(s, p).waypoints) {
@@ -303,18 +314,10 @@ TEST(RobustTrajectory, DepthIsSmoothedAlongAFlatSeam) {
 // off at worst). The roots' own heights, smoothed over +-24 mm as a corner joint's are, keep
 // most of the waves (1.38 mm).
 TEST(RobustTrajectory, GrooveDepthIsSmoothedLongerThanItsTop) {
-  SeamCandidate s;
-  for (int k = 0; k <= 200; ++k) {
-    GrooveSection g;
-    g.ok = true;
-    const double x = -0.15 + 0.0015 * k, wave = 0.0015 * std::sin(2 * M_PI * x / 0.05);
-    g.root = Eigen::Vector3d(x, 0, 0.4 + wave);  // the top at z = 0.392 all along
-    g.depth = 0.008 + wave;
-    g.tangent = Eigen::Vector3d(1, 0, 0);
-    g.normal = g.bisector = Eigen::Vector3d(0, 0, -1);
-    s.sections.push_back(g);
-  }
-  s.accepted = true;
+  const auto wave = [](double x) { return 0.0015 * std::sin(2 * M_PI * x / 0.05); };
+  // The top at z = 0.392 all along.
+  SeamCandidate s =
+      straight_seam([](double) { return 0.0; }, wave, [&](double x) { return 0.008 + wave(x); });
   const auto inner_wave = [&s]() {
     double worst = 0;
     for (const Waypoint& w : seam_trajectory(s, RobustParams{}).waypoints) {

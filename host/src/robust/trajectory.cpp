@@ -7,6 +7,8 @@
 #include <groovetrace/error.hpp>
 #include <groovetrace/robust.hpp>
 
+#include "core/stats.hpp"
+
 namespace groovetrace {
 namespace {
 
@@ -194,8 +196,7 @@ void blend_orientation(TorchPath& path, double blend, bool closed) {
   }
 }
 
-// The arc-length offset (m) from root k to root j (rings wrap), and the half-window (m) about
-// root k: `half`, shrunk near an open path's ends to stay centred.
+// The arc-length offset (m) from root k to root j (rings wrap).
 double arc_offset(const TorchPath& path, std::size_t k, std::size_t j, bool closed) {
   const double L = path.S.back();
   double d = path.S[j] - path.S[k];
@@ -203,14 +204,10 @@ double arc_offset(const TorchPath& path, std::size_t k, std::size_t j, bool clos
   return d;
 }
 
+// The half-window (m) about root k: `half`, shrunk near an open path's ends to stay centred.
 double centred_half(const TorchPath& path, std::size_t k, double half, bool closed) {
   const double L = path.S.back();
   return closed ? half : std::min(half, std::min(path.S[k], L - path.S[k]));
-}
-
-double tricube(double d, double h) {
-  const double u = h > 0 ? std::abs(d) / h : 0.0;
-  return std::pow(1 - u * u * u, 3);
 }
 
 // The groove's depth at root k: the tricube-weighted mean of the roots' depths over `half`
@@ -219,10 +216,9 @@ double mean_depth(const TorchPath& path, std::size_t k, double half, bool closed
   const double h = centred_half(path, k, half, closed);
   double sw = 0, sd = 0;
   for (std::size_t j = 0; j < n; ++j) {
-    const double d = arc_offset(path, k, j, closed);
-    if (std::abs(d) >= h && j != k) continue;
-    sw += tricube(d, h);
-    sd += tricube(d, h) * path.D[j];
+    const double w = tricube_weight(arc_offset(path, k, j, closed), h);
+    sw += w;
+    sd += w * path.D[j];
   }
   return sw > 0 ? sd / sw : path.D[k];
 }
@@ -251,17 +247,18 @@ void smooth_depth(TorchPath& path, double half, bool closed, bool corner) {
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (std::size_t j = 0; j < n; ++j) {
       const double d = arc_offset(path, k, j, closed);
-      if (std::abs(d) >= h && j != k) continue;
+      const double w = tricube_weight(d, h);
+      if (w <= 0) continue;
       const Eigen::Vector3d x(1, d, d * d);
-      const double top = (path.P[j] - path.P[k]).dot(path.N[k]) + (corner ? 0.0 : path.D[j]);
-      A += tricube(d, h) * x * x.transpose();
-      b += tricube(d, h) * x * top;
+      A += w * x * x.transpose();
+      b += w * x * ((path.P[j] - path.P[k]).dot(path.N[k]) + (corner ? 0.0 : path.D[j]));
     }
     const Eigen::Vector3d c = A.ldlt().solve(b);
-    const double depth = corner ? 0.0 : mean_depth(path, k, kDepthWindow * half, closed, n);
-    lift[k] = A(2, 2) > 1e-12 * A(0, 0) && c.allFinite() ? c[0] - depth
-              : corner                                   ? 0.0
-                                                         : path.D[k] - depth;
+    // Where the window holds too few roots for a quadratic (an open path's ends), the root's
+    // own top.
+    const double top =
+        A(2, 2) > 1e-12 * A(0, 0) && c.allFinite() ? c[0] : (corner ? 0.0 : path.D[k]);
+    lift[k] = top - (corner ? 0.0 : mean_depth(path, k, kDepthWindow * half, closed, n));
   }
   for (std::size_t k = 0; k < n; ++k) path.P[k] += lift[k] * path.N[k];
   if (closed) path.P[n] = path.P[0];
