@@ -45,6 +45,25 @@ std::size_t count_files(const fs::path& dir, const std::string& suffix) {
   return n;
 }
 
+// scan.json (path -> text) of every whole scan directory under `out`; one still under .partial
+// (between its files and its rename) is not done. Empty while the batch is still renaming:
+// a directory that vanishes under the walk makes it throw.
+std::map<std::string, std::string> done_scans(const fs::path& out) {
+  std::map<std::string, std::string> done;
+  try {
+    if (!fs::exists(out)) return done;
+    for (const auto& e : fs::recursive_directory_iterator(out)) {
+      if (e.path().filename() == "scan.json" &&
+          e.path().string().find("/.partial/") == std::string::npos) {
+        done[e.path().string()] = test::read_text(e.path());
+      }
+    }
+  } catch (const std::exception&) {
+    return {};
+  }
+  return done;
+}
+
 // index.html as a person sees it: Chromium (Debian's, installed by scripts/setup.sh) loads it
 // from the file system headless; returns the DOM after load and fills `log` with what the
 // browser said (resource and script errors land there).
@@ -194,7 +213,9 @@ TEST_F(CliBatch, KilledBatchResumes) {
   }
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::seconds(120 * test::kSlowdown);
-  while (fs::exists(dir_ / "out") ? count_files(dir_ / "out", "scan.json") < 2 : true) {
+  // Wait for two whole scan directories: a scan.json still under .partial is not done yet (it
+  // was counted once, and the kill then came before its rename: CI saw one done scan of two).
+  while (done_scans(dir_ / "out").size() < 2) {
     ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the batch made no progress";
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -204,15 +225,7 @@ TEST_F(CliBatch, KilledBatchResumes) {
   ASSERT_TRUE(WIFSIGNALED(status));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // its worker follows it
 
-  // scan.json of the scans done before the kill; a directory still under .partial (the kill
-  // came between its files and its rename) is not done.
-  std::map<std::string, std::string> before;
-  for (const auto& e : fs::recursive_directory_iterator(dir_ / "out")) {
-    if (e.path().filename() == "scan.json" &&
-        e.path().string().find("/.partial/") == std::string::npos) {
-      before[e.path().string()] = test::read_text(e.path());
-    }
-  }
+  const std::map<std::string, std::string> before = done_scans(dir_ / "out");
   ASSERT_GE(before.size(), 2u);
   ASSERT_LT(before.size(), 6u) << "the batch finished before the kill";
 
