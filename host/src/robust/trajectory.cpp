@@ -232,12 +232,14 @@ double mean_depth(const TorchPath& path, std::size_t k, double half, bool closed
 // where two steep walls fitted to a few image rows each meet, scatters in depth by 1-3 mm at
 // 640x480 where the top beside it, fitted to the wide top surfaces, moves by about 1 mm (the
 // sweep's v16-90 s319: the path's depth error 1.34 mm rms with the roots smoothed alone, in
-// 40-60 mm waves; 0.89 mm now). A corner joint's depth is its weld's throat, not a groove's:
-// there the roots' own heights are smoothed. Only the path moves: the sections (and with
-// them the region and the reported stations) keep their roots.
+// 40-60 mm waves; 0.89 mm now). A corner joint (fillet, lap) is taken alike: its depth is
+// the weld's throat, from the root to the line through its leg ends on the two faces, and
+// those faces are fitted as widely as a groove's top (the sweep's lap s310: 0.65 -> 0.53 mm
+// depth error). Only the path moves: the sections (and with them the region and the reported
+// stations) keep their roots.
 constexpr double kDepthWindow = 3.0;
 
-void smooth_depth(TorchPath& path, double half, bool closed, bool corner) {
+void smooth_depth(TorchPath& path, double half, bool closed) {
   const std::size_t n = closed ? path.P.size() - 1 : path.P.size();
   if (n < 5) return;
   std::vector<double> lift(n, 0.0);
@@ -251,14 +253,13 @@ void smooth_depth(TorchPath& path, double half, bool closed, bool corner) {
       if (w <= 0) continue;
       const Eigen::Vector3d x(1, d, d * d);
       A += w * x * x.transpose();
-      b += w * x * ((path.P[j] - path.P[k]).dot(path.N[k]) + (corner ? 0.0 : path.D[j]));
+      b += w * x * ((path.P[j] - path.P[k]).dot(path.N[k]) + path.D[j]);
     }
     const Eigen::Vector3d c = A.ldlt().solve(b);
     // Where the window holds too few roots for a quadratic (an open path's ends), the root's
     // own top.
-    const double top =
-        A(2, 2) > 1e-12 * A(0, 0) && c.allFinite() ? c[0] : (corner ? 0.0 : path.D[k]);
-    lift[k] = top - (corner ? 0.0 : mean_depth(path, k, kDepthWindow * half, closed, n));
+    const double top = A(2, 2) > 1e-12 * A(0, 0) && c.allFinite() ? c[0] : path.D[k];
+    lift[k] = top - mean_depth(path, k, kDepthWindow * half, closed, n);
   }
   for (std::size_t k = 0; k < n; ++k) path.P[k] += lift[k] * path.N[k];
   if (closed) path.P[n] = path.P[0];
@@ -311,7 +312,7 @@ Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params
   }
   drop_folds(secs, closed);
   TorchPath path = torch_path(secs, closed);
-  smooth_depth(path, params.depth_smooth, closed, seam.corner);
+  smooth_depth(path, params.depth_smooth, closed);
   blend_orientation(path, params.orientation_blend, closed);
   const std::vector<Eigen::Vector3d>& P = path.P;
   const std::vector<double>& S = path.S;
