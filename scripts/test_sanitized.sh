@@ -18,19 +18,24 @@ export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
 # A sanitized scan runs about ten times slower: the tests that run whole scans again and again
 # run fewer or smaller ones (tests/support/scenes.hpp, small_runs), with the same assertions.
 export GT_TEST_SMALL=1
-# Left to the Release suite: a quarter of this suite's time instrumented, for little that the
+# Left to the Release suite: a third of this suite's time instrumented, for little that the
 # tests kept here do not run. Tests whose subject is the process rather than its memory - a
 # real Slurm cluster and the installed package; kills at random moments, a hang past its time
 # limit, concurrent runs and thread counts (races are ThreadSanitizer's field); the peak memory
-# of runs (ASan's shadow and quarantine would be what they measure) - and two full-frame
-# (1280x720) accuracy scenes whose joints, bevel and tacks, 640x480 scenes run here.
+# of runs (ASan's shadow and quarantine would be what they measure); a batch of depth PNGs (the
+# PNG reader and the batch run here in their own tests) - and full-frame (1280x720) accuracy
+# scenes whose stages 640x480 scenes and section tests run here (a bevel at the coarser scale,
+# tacks, high-low, a channel beside a loose bar).
 release_only=(
   slurm_cluster install_consumer 'Resources\.PeakMemoryOfARunIsBoundedByItsPoints'
   'OutputSet\.KillsAtRandomMomentsLeaveOneWholeSet' 'OutputSet\.ConcurrentRunsNeverMix'
   'CliBatch\.KilledBatchResumes' 'CliBatch\.HangingScanTimesOut'
   'CliRun\.OutputsAreTheSameForEveryThreadCount'
+  'CliDepthPng\.BatchTakesDepthPngsWithIntrinsicsAndNotItsOwnPictures'
   'RobustDetect\.SingleBevelIsReadAtACoarserScaleWhenTheBaseFails'
   'RobustDetect\.TacksAreReportedAndThePathStaysOnTheRoot'
+  'RobustDetect\.HighLowIsReportedAndALevelJointIsNot'
+  'RobustDetect\.ChannelBesideALooseBarIsNoJoint'
 )
 exclude="^($(IFS='|'; echo "${release_only[*]}"))\$"
 log=build-asan/sanitized-ctest.log
