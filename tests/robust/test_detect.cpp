@@ -461,6 +461,23 @@ TEST(RobustDetect, HighLowIsReportedAndALevelJointIsNot) {
   EXPECT_LT(best_accepted(level.det)->misalignment, 5e-4);
 }
 
+// The same 1.5 mm high-low at 640x480 from 0.40 m, 10 deg off square: a station's step swings
+// by 2-3 mm, and taken per station it turned the torch 3.1 deg off the bisector on average.
+// Read along the whole seam by both passes, with the plates' sides parallel, the seam's step
+// is held at every station: 0.8 deg.
+TEST(RobustDetect, HighLowSeamHoldsItsStepAtEveryStation) {
+  SynthParams sp = vga_joint(901);
+  sp.tilt_deg = -10;
+  sp.misalignment = 0.0015;
+  const JointRun run(sp);
+  ASSERT_GT(accepted_count(run.det), 0u);
+  const SeamCandidate& s = *best_accepted(run.det);
+  EXPECT_NEAR(s.misalignment, 0.0015, 5e-4);
+  const auto [dist, angle] = run.errors(s);
+  EXPECT_LT(dist, 0.0006);
+  EXPECT_LT(angle, 1.5);
+}
+
 // A 100 mm wide panel joint (150 deg): ten times the width the default scale's window holds;
 // the search at a larger scale finds it.
 TEST(RobustDetect, WidePanelJointIsFoundAtItsOwnScale) {

@@ -2,6 +2,7 @@
 // against analytic V profiles, and the shapes that are not V-grooves.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -349,6 +350,56 @@ TEST(RobustSection, HighLowPlatesReportTheirMisalignment) {
   EXPECT_NEAR(g.edge_right.x(), ur, 1e-4);
   EXPECT_NEAR(g.edge_right.y(), rise, 1e-4);
   EXPECT_NEAR(g.opening_deg, 60.0, 0.2);
+  // With the seam's step held (VFit::step) rather than the station's own, the same.
+  stepped.step = rise;
+  const VProfile h = fit_v_profile(pts, 0.02, stepped);
+  ASSERT_TRUE(h.ok) << h.why;
+  EXPECT_NEAR(h.top[1], 0.0, 1e-3);
+  EXPECT_NEAR(h.edge_right.y(), rise, 1e-4);
+}
+
+// The same high-low V with 0.3 mm noise and tops waving by +-0.1 mm over 12 mm: the step read
+// from the tops beyond the edges (misalignment) errs by 0.18 mm mean, the outer half's lines'
+// (outer_step) by 0.29 mm; the parallel plates' median bend is 0, and a right top bending away
+// (a curved part's far side at a slant) reads its bend. Waves of 0.2 mm bring the two steps
+// level and of 0.3 mm reverse them: the sweep's high-low scans showed the edges' step
+// scattering a third less along the seam.
+TEST(RobustSection, HighLowStepIsReadBeyondTheEdges) {
+  const double depth = 0.008, rise = 0.0015, k = 1 / std::tan(M_PI / 3);
+  const double ul = -depth * k, ur = (depth + rise) * k;
+  const auto profile = [&](unsigned seed, double bend) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> gauss(0.0, 0.0003);
+    std::uniform_real_distribution<double> phase(0.0, 2 * M_PI);
+    const double ph = phase(rng);
+    std::vector<Eigen::Vector2d> pts;
+    for (int row = 0; row < 4; ++row) {
+      for (double u = -0.02 + 0.0002 * row; u <= 0.02; u += 0.0008) {
+        double v = u < ul ? 0.0 : u > ur ? rise : u <= 0 ? -depth * (u - ul) / -ul : -depth + u / k;
+        if (u < ul || u > ur) v += 0.0001 * std::sin(2 * M_PI * u / 0.012 + ph);
+        if (u > ur) v += bend * (u - ur);
+        pts.emplace_back(u, v + gauss(rng));
+      }
+    }
+    return pts;
+  };
+  // One station's bend swings with the waves; a seam's median of them does not.
+  double err_edges = 0, err_outer = 0;
+  std::vector<double> level_bend, bent_bend;
+  for (unsigned seed = 1; seed <= 41; ++seed) {
+    const VProfile f = fit_v_profile(profile(seed, 0.0), 0.02);
+    const VProfile g = fit_v_profile(profile(seed, 0.08), 0.02);
+    ASSERT_TRUE(f.ok && g.ok) << f.why << g.why;
+    err_edges += std::abs(f.misalignment - rise);
+    err_outer += std::abs(f.outer_step - rise);
+    level_bend.push_back(f.top_bend);
+    bent_bend.push_back(g.top_bend);
+  }
+  EXPECT_LT(err_edges, 0.8 * err_outer) << err_edges / 41 << " " << err_outer / 41;
+  std::nth_element(level_bend.begin(), level_bend.begin() + 20, level_bend.end());
+  std::nth_element(bent_bend.begin(), bent_bend.begin() + 20, bent_bend.end());
+  EXPECT_NEAR(level_bend[20], 0.0, 0.01);
+  EXPECT_NEAR(bent_bend[20], 0.08, 0.02);
 }
 
 TEST(RobustSection, CurvedTopOfAPipeIsNotAGroove) {

@@ -43,6 +43,12 @@ struct GrooveSection {
   bool square_side = false;
   double wall_left_deg = 0, wall_right_deg = 0;  ///< each wall's dip below the top (deg)
   double misalignment = 0;  ///< top on the right (across) side minus the left's (m): high-low
+  /// Two-wall V's: the right top side's slope minus the left's beyond the edges (dv/du in the
+  /// section's frame; NaN when a side is too short). Plates set high-low stay parallel.
+  double top_bend = NAN;
+  /// The right top side's height minus the left's above the root from lines through each
+  /// side's outer half of the window (m): the step a station fitted on its own holds.
+  double outer_step = 0;
   /// The root gap measured at this station (m; two-wall V's, else 0). Once the seam's gap is
   /// applied, `root` is the middle of the opening at the root faces and `depth` is to there.
   double gap = 0;

@@ -195,6 +195,8 @@ GrooveSection fit_section(const Cloud& cloud, const std::vector<std::uint32_t>& 
   sec.wall_left_deg = f.wall_left_deg;
   sec.wall_right_deg = f.wall_right_deg;
   sec.misalignment = f.misalignment;
+  sec.top_bend = f.top_bend;
+  sec.outer_step = f.outer_step;
   sec.gap = f.gap;
   sec.inside = f.inside;
   sec.corner = f.corner;

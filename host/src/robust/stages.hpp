@@ -80,6 +80,12 @@ struct VProfile {
   bool square_side = false;
   /// The right top side's height minus the left's above the root (m): plates set high-low.
   double misalignment = 0.0;
+  /// Two-wall V's: the right top side's slope minus the left's beyond the edges (dv/du, NaN
+  /// when a side is too short). Plates set high-low are parallel, near 0.
+  double top_bend = NAN;
+  /// The right top side's height minus the left's from lines through each side's outer half of
+  /// the window (m): the step a stepped fit holds when the seam holds none (VFit::step).
+  double outer_step = 0.0;
   /// Two-wall V's: the root gap's width estimated from the points below the walls (m, 0 when
   /// none; v_profile.cpp, step 7). `root` stays the walls' intersection.
   double gap = 0.0;
@@ -105,9 +111,15 @@ struct VFit {
   /// levelled to its top), and where that side is hidden, its foot is the root.
   int square = 0;
   /// The plates are set high-low: the two top sides are fitted with one slope and each its own
-  /// height (their step held at what lines fitted to each side alone give), so the step does
-  /// not tilt the top normal or move the edges. Not with `symmetric`.
+  /// height (their step held, see `step`), so the step does not tilt the top normal or move the
+  /// edges. Not with `symmetric`.
   bool stepped = false;
+  /// With `stepped`: the seam's step held at every station, right top side minus left (m), the
+  /// median of the first pass's stations; NaN: each station's own (its outer half's lines).
+  /// One station's step swings by 1-3 mm with the undulation under each side (a 1.5 mm
+  /// high-low at 0.45 m, 640x480); held per station it turned the top normal by 3-5 deg this
+  /// way and that along the seam.
+  double step = NAN;
   /// The seam has a root gap (its first pass's median gap is above 0): where a station's
   /// slot shows, the V is refitted without the slot's points (v_profile.cpp, step 7). Only
   /// then: on a seam without a gap, a station's few stray deep points are noise.

@@ -112,6 +112,40 @@ std::pair<Eigen::Vector3d, double> robust_detail::fit_poly(const std::vector<Eig
 
 namespace {
 
+// The heights of two top sides `lo` (left) and `hi` (right) as one curve a + b u + c u^2 with
+// the right side raised by a step: (a, b, c, step), Tukey-reweighted as fit_poly; `m` = 4
+// fits c, 3 holds it at 0.
+Eigen::Vector4d fit_stepped_top(const std::vector<Eigen::Vector2d>& lo,
+                                const std::vector<Eigen::Vector2d>& hi, int m) {
+  const auto row = [m](double u, bool right) {
+    return Eigen::Vector4d(1, u, m == 4 ? u * u : 0.0, right ? 1.0 : 0.0);
+  };
+  std::vector<double> w(lo.size() + hi.size(), 1.0), r(w.size());
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();
+  for (int iter = 0; iter < 6; ++iter) {
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (std::size_t k = 0; k < w.size(); ++k) {
+      const bool right = k >= lo.size();
+      const Eigen::Vector2d& p = right ? hi[k - lo.size()] : lo[k];
+      A += w[k] * row(p.x(), right) * row(p.x(), right).transpose();
+      b += w[k] * p.y() * row(p.x(), right);
+    }
+    if (m == 3) A(2, 2) = 1.0;  // c held at 0
+    const Eigen::Vector4d sol = A.ldlt().solve(b);
+    if (!sol.allFinite()) break;
+    x = sol;
+    for (std::size_t k = 0; k < w.size(); ++k) {
+      const bool right = k >= lo.size();
+      const Eigen::Vector2d& p = right ? hi[k - lo.size()] : lo[k];
+      r[k] = p.y() - row(p.x(), right).dot(x);
+    }
+    const double sigma = std::max(robust_sigma(r), 1e-7);
+    for (std::size_t k = 0; k < w.size(); ++k) w[k] = tukey_weight_or_one(r[k], kTukeyC * sigma);
+  }
+  return x;
+}
+
 // Angle (deg) by which `wall` (unit, from the edge towards the root) dips below the top's
 // tangent `inward` (unit, along the top towards the groove). Positive: into the material.
 double dip_deg(const Eigen::Vector2d& inward, const Eigen::Vector2d& wall, bool left) {
@@ -407,7 +441,8 @@ struct ProfileFit {
   double vertex_zone = 0;              // points this near a vertex stay out of the fits
   double top_step = 0;                 // right top side's line minus the left's at u = 0
   bool stepped = false;                // fit the tops with a step (VFit::stepped)
-  double step = 0;                     // the step held in the fit: top_step, or 0
+  double seam_step = NAN;              // the seam's step (VFit::step)
+  double step = 0;                     // the step held in the fit (stepped), or 0
   Eigen::Vector2d view{0, 1};          // unit, towards the sensor
   // Height of the top `q` at u on the side of u = 0 where u lies.
   double top(const Eigen::Vector3d& q, double u) const { return top_at(q, u) + (u > 0 ? step : 0); }
@@ -439,7 +474,7 @@ bool fit_top(ProfileFit& f, Eigen::Vector3d& q) {
   }
   if (n_left < 3 && n_right < 3) return false;
   f.top_step = top_step(f.outer);
-  f.step = f.stepped ? f.top_step : 0.0;
+  f.step = !f.stepped ? 0.0 : std::isnan(f.seam_step) ? f.top_step : f.seam_step;
   // The right side lowered by the step (a copy only when there is one: this runs per section).
   std::vector<Eigen::Vector2d> lowered;
   if (f.step != 0.0) {
@@ -523,6 +558,35 @@ VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector
 
 // The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
 // opening and bisector. `fallback_noise` (m) when the top has no inliers.
+// The tops beyond a two-wall V's fitted edges (a vertex zone out, within the window): one
+// curve with a step at the groove, v = a + b u + c u^2 + step [right side], Tukey-reweighted
+// (c held at 0 when it would bend more than the top's bound, |c| <= 0.5 / W). On the sweep's
+// noisy 1.5 mm high-low scans a station's step read so scatters a third less than the outer
+// half's lines' (top_step), from more points. Also each side's line slope there
+// (right minus left, dv/du): plates set high-low stay parallel; the two sides of a curved
+// part seen at a slant diverge, and their lines then differ in height by a millimetre or two.
+struct TopSides {
+  double step = 0.0;
+  double bend = NAN;  // NaN without three points on each side
+};
+
+TopSides top_sides(const ProfileFit& f, const VModel& v) {
+  std::vector<Eigen::Vector2d> lo, hi;
+  for (const auto& p : f.pts) {
+    if (p.x() < v.u_left - f.vertex_zone) lo.push_back(p);
+    if (p.x() > v.u_right + f.vertex_zone) hi.push_back(p);
+  }
+  if (lo.size() < 3 || hi.size() < 3) return {f.top_step, NAN};
+  TopSides out;
+  out.bend = fit_poly(hi, 1).first[1] - fit_poly(lo, 1).first[1];
+  for (int m : {4, 3}) {  // with the quadratic term, then without
+    const Eigen::Vector4d x = fit_stepped_top(lo, hi, m);
+    out.step = x[3];
+    if (m == 3 || std::abs(x[2]) <= 0.5 / f.W) break;
+  }
+  return out;
+}
+
 VProfile describe_v(const VModel& v, const PieceStats& st, double fallback_noise) {
   VProfile o;
   const Eigen::Vector2d el = v.edge_left(), er = v.edge_right();
@@ -579,7 +643,12 @@ VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   const PieceStats st = piece_stats(f.pts, v, f.scale, f.vertex_zone);
   VProfile o = describe_v(v, st, f.sigma);
   o.one_wall = one_wall;
-  o.misalignment = f.top_step;
+  o.misalignment = o.outer_step = f.top_step;
+  if (!one_wall) {
+    const TopSides sides = top_sides(f, v);
+    o.misalignment = sides.step;
+    o.top_bend = sides.bend;
+  }
   o.inside = st.inside;
   const char* why = why_not_v(o, st, f, one_wall ? 0 : kMinWall);
   if (why) {
@@ -863,6 +932,7 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
   ProfileFit f;
   f.W = half_window;
   f.stepped = mode.stepped;
+  f.seam_step = mode.step;
   f.view = view.normalized();
   f.pts.reserve(all.size());
   for (const auto& p : all) {
