@@ -556,8 +556,6 @@ VModel initial_v(const std::vector<Eigen::Vector2d>& groove, const Eigen::Vector
   return m;
 }
 
-// The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
-// opening and bisector. `fallback_noise` (m) when the top has no inliers.
 // The tops beyond a two-wall V's fitted edges (a vertex zone out, within the window): one
 // curve with a step at the groove, v = a + b u + c u^2 + step [right side], Tukey-reweighted
 // (c held at 0 when it would bend more than the top's bound, |c| <= 0.5 / W). On the sweep's
@@ -587,6 +585,8 @@ TopSides top_sides(const ProfileFit& f, const VModel& v) {
   return out;
 }
 
+// The profile's quantities for the V `v`: edges, point counts, width, depth, the walls' dips,
+// opening and bisector. `fallback_noise` (m) when the top has no inliers.
 VProfile describe_v(const VModel& v, const PieceStats& st, double fallback_noise) {
   VProfile o;
   const Eigen::Vector2d el = v.edge_left(), er = v.edge_right();
