@@ -79,9 +79,11 @@ struct VProfile {
   /// the root at its foot - a single bevel seen along its square side.
   bool square_side = false;
   /// The right top side's height minus the left's above the root (m): plates set high-low.
+  /// From the tops beyond the edges on a two-wall V that passed, else `outer_step`.
   double misalignment = 0.0;
-  /// Two-wall V's: the right top side's slope minus the left's beyond the edges (dv/du, NaN
-  /// when a side is too short). Plates set high-low are parallel, near 0.
+  /// Two-wall V's that passed: the right top side's slope minus the left's beyond the edges
+  /// (dv/du, NaN when a side is too short, and on every other fit). Plates set high-low are
+  /// parallel, near 0.
   double top_bend = NAN;
   /// The right top side's height minus the left's from lines through each side's outer half of
   /// the window (m): the step a stepped fit holds when the seam holds none (VFit::step).

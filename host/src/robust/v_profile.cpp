@@ -638,23 +638,25 @@ const char* why_not_v(const VProfile& o, const PieceStats& st, const ProfileFit&
 }
 
 // The profile of the V `v` and whether it is one (see why_not_v). `one_wall`: one wall's
-// points are not required.
+// points are not required. The tops beyond the edges are fitted only for a two-wall V that
+// passed: only those sections' steps and bends are read (score.cpp, trace.cpp, outputs), and
+// a station judges up to three V's.
 VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   const PieceStats st = piece_stats(f.pts, v, f.scale, f.vertex_zone);
   VProfile o = describe_v(v, st, f.sigma);
   o.one_wall = one_wall;
   o.misalignment = o.outer_step = f.top_step;
-  if (!one_wall) {
-    const TopSides sides = top_sides(f, v);
-    o.misalignment = sides.step;
-    o.top_bend = sides.bend;
-  }
   o.inside = st.inside;
   const char* why = why_not_v(o, st, f, one_wall ? 0 : kMinWall);
   if (why) {
     o.why = why;
-  } else {
-    o.ok = true;
+    return o;
+  }
+  o.ok = true;
+  if (!one_wall) {
+    const TopSides sides = top_sides(f, v);
+    o.misalignment = sides.step;
+    o.top_bend = sides.bend;
   }
   return o;
 }
