@@ -638,9 +638,7 @@ const char* why_not_v(const VProfile& o, const PieceStats& st, const ProfileFit&
 }
 
 // The profile of the V `v` and whether it is one (see why_not_v). `one_wall`: one wall's
-// points are not required. The tops beyond the edges are fitted only for a two-wall V that
-// passed: only those sections' steps and bends are read (score.cpp, trace.cpp, outputs), and
-// a station judges up to three V's.
+// points are not required. The tops beyond the edges are left to with_top_sides.
 VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
   const PieceStats st = piece_stats(f.pts, v, f.scale, f.vertex_zone);
   VProfile o = describe_v(v, st, f.sigma);
@@ -653,11 +651,16 @@ VProfile judge_v(const VModel& v, bool one_wall, const ProfileFit& f) {
     return o;
   }
   o.ok = true;
-  if (!one_wall) {
-    const TopSides sides = top_sides(f, v);
-    o.misalignment = sides.step;
-    o.top_bend = sides.bend;
-  }
+  return o;
+}
+
+// The two-wall V `o` that passed (model `m`) with the step and bend of the tops beyond its
+// edges. Fitted once per station, for the V it returns: only those sections' steps and bends
+// are read (score.cpp, trace.cpp, outputs), and a station judges up to three V's.
+VProfile with_top_sides(VProfile o, const ProfileFit& f, const VModel& m) {
+  const TopSides sides = top_sides(f, m);
+  o.misalignment = sides.step;
+  o.top_bend = sides.bend;
   return o;
 }
 
@@ -970,7 +973,10 @@ VProfile fit_v(const std::vector<Eigen::Vector2d>& all, double half_window, VFit
   }
   VProfile two_wall = judge_v(m, false, f);
   if (!two_wall.ok) two_wall = past_the_slot(groove, q, f, tie, m, two_wall);
-  if (two_wall.ok) return with_root_gap(m, f, tie, two_wall, mode.root_gap);
+  if (two_wall.ok) {
+    const VProfile out_v = with_root_gap(m, f, tie, two_wall, mode.root_gap);  // may refit m
+    return with_top_sides(out_v, f, m);
+  }
   return one_wall_v(m, two_wall, f, groove, mode);
 }
 
