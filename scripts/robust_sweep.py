@@ -844,6 +844,9 @@ def no_joint_run(binary, out_root, spec):
     rec["synth_cmd"] = ("groovetrace synth " + " ".join(shlex.quote(a) for a in spec["synth"]) +
                         "; joint filled in by fill_joint")
     scan = render(binary, out_root, spec["scan"], spec["synth"])
+    if scan is None:  # render logged why (a full disk ended a sweep here in a traceback)
+        rec.update(rc=-1, wall_s=0.0, stderr=["synth failed"], cmd="")
+        return rec
     filled = os.path.join(out_root, "variants", "no_joint", spec["scan"] + ".pcd")
     os.makedirs(os.path.dirname(filled), exist_ok=True)
     fill_joint(scan, filled, spec["seed"])
