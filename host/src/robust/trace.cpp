@@ -245,32 +245,58 @@ GrooveSection section_ahead(const Context& ctx, const OkMedians& med, const Eige
   return sec;
 }
 
+// Tracking crosses up to kBridge (m) of stations that do not fit - a clamp hiding the
+// groove, a shallow groove's stretch lost in the noise - when the groove resumes beyond in
+// kResume V fits in a row on the tracked line; fewer, and the stations past the gap are
+// dropped (one or two fits pass beyond a plate's end, where a slab half on the end face
+// still fits a V).
+constexpr double kBridge = 0.02;
+constexpr int kResume = 3;
+
+// Whether a V fit past a gap continues the seam: on the tracked line within 2 mm across and
+// in depth, with the seam's width and depth within 30 %.
+bool resumes(const GrooveSection& sec, const Eigen::Vector3d& at, const OkMedians& med) {
+  const Eigen::Vector3d off = sec.root - at;
+  const auto near = [](double x, double ref) { return std::abs(x - ref) <= 0.3 * ref; };
+  return std::abs(off.dot(sec.across())) <= 0.002 && std::abs(off.dot(sec.normal)) <= 0.002 &&
+         near(sec.width, med.width) && near(sec.depth, med.depth);
+}
+
 // Extends `secs` past its last section by tracking (see extend_ends): trailing stations whose
-// own fit failed are dropped first; misses are kept only if a later fit passes.
+// own fit failed are dropped first; misses are kept only if a later fit passes (after a gap
+// of more than one miss, kResume fits).
 void extend_back(const Context& ctx, const OkMedians& med, std::vector<GrooveSection>& secs,
                  VFit mode) {
   const double reach = 10 * ctx.params.scale;  // at most 100 mm more per end
+  const int max_misses = std::max(2, static_cast<int>(kBridge / ctx.params.station));
   while (!secs.empty() && !secs.back().ok && !secs.back().inferred) secs.pop_back();
   std::vector<GrooveSection> pending;
-  int misses = 0;
+  int misses = 0, probation = 0;  // probation: fits still needed past a gap
+  std::size_t kept = secs.size();
   for (double grown = 0; grown < reach; grown += ctx.params.station) {
     Eigen::Vector3d at, tangent;
     if (!continue_seam(ctx, secs, misses + 1, at, tangent)) break;
     const Eigen::Vector3d normal = secs.back().normal;
     GrooveSection sec = section_ahead(ctx, med, at, tangent, normal, mode);
-    if (sec.ok || sec.inferred) {
+    if (sec.ok && (misses >= 2 || probation > 0) && !resumes(sec, at, med)) sec.ok = false;
+    if (sec.ok || (sec.inferred && probation == 0 && misses < 2)) {
+      if (misses >= 2) probation = kResume;
       secs.insert(secs.end(), pending.begin(), pending.end());
       pending.clear();
       secs.push_back(sec);
       misses = 0;
+      if (probation > 0) --probation;
+      if (probation == 0) kept = secs.size();
     } else {
+      if (probation > 0) break;
       sec.root = at;
       sec.tangent = tangent;
       sec.normal = normal;
       pending.push_back(sec);
-      if (++misses >= 2) break;
+      if (++misses >= max_misses) break;
     }
   }
+  secs.erase(secs.begin() + static_cast<std::ptrdiff_t>(kept), secs.end());
 }
 
 // Extends an open seam past its ends by tracking: from the last ok sections, step one station
