@@ -335,6 +335,35 @@ TEST(RobustTrajectory, GrooveDepthIsSmoothedLongerThanItsTop) {
       0.0012);
 }
 
+// A tack weld fills 15 mm of a flat seam (x in 0..15 mm): its stations' own fits failed
+// (`filled`), and the roots smoothing gave them from the tack's flanks, which still pass as
+// shallower V's (1 mm high, 7 mm deep, 3 mm either side), lie 2 mm high with the seam's 8 mm
+// depth under them: a top 2 mm above the part's (the sweep's tacks s352: the path 1.2-1.8 mm
+// over each tack). The stations on the seam's reported tack (flanks included) give neither
+// top nor depth: the path stays on the root line through it.
+TEST(RobustTrajectory, APathStaysOnTheRootThroughATack) {
+  const auto tack = [](double x) { return x >= 0 && x < 0.015; };
+  const auto flank = [&](double x) { return !tack(x) && x >= -0.003 && x < 0.018; };
+  SeamCandidate s = straight_seam([](double) { return 0.0; },
+                                  [&](double x) {
+                                    return tack(x) ? -0.002 : flank(x) ? -0.001 : 0.0;
+                                  },
+                                  [&](double x) { return flank(x) ? 0.007 : 0.008; });
+  for (GrooveSection& g : s.sections) {
+    g.s = g.root.x() + 0.15;
+    if (tack(g.root.x())) g.ok = false, g.filled = true;
+  }
+  const auto worst = [](const SeamCandidate& seam) {
+    double w = 0;
+    for (const Waypoint& p : seam_trajectory(seam, RobustParams{}).waypoints)
+      w = std::max(w, std::abs(p.position.z() - 0.4));
+    return w;
+  };
+  EXPECT_GT(worst(s), 0.0015);  // as long as no tack is reported there
+  s.tacks.push_back({0.15 + 0.0075, 0.021});
+  EXPECT_LT(worst(s), 0.0002);
+}
+
 // A seam that curves in depth (half a ring of radius 50 mm round a pipe, the normal radial)
 // keeps its shape: the quadratic follows the curvature.
 TEST(RobustTrajectory, DepthSmoothingFollowsAPipe) {

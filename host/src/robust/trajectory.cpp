@@ -90,6 +90,8 @@ struct TorchPath {
   std::vector<Eigen::Vector3d> P, B, T, N;  ///< N: the top surface normal
   std::vector<double> S;
   std::vector<double> D;  ///< the groove's depth, root below the top along N (m)
+  /// 0 on a tack weld, else 1: the weight of the root's top and depth in smooth_depth.
+  std::vector<double> W;
 };
 
 // The root `reach` (m) or more before (dir = -1) or after (+1) root k along the path (rings
@@ -106,7 +108,15 @@ std::size_t root_at_reach(const std::vector<GrooveSection>& secs, std::size_t k,
   return j;
 }
 
-TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
+// Whether station `sec` lies on one of `tacks` (arc lengths along the seam, m).
+bool on_tack(const GrooveSection& sec, const std::vector<SeamCandidate::Tack>& tacks) {
+  return std::any_of(tacks.begin(), tacks.end(), [&](const SeamCandidate::Tack& t) {
+    return std::abs(sec.s - t.position) <= 0.5 * t.length;
+  });
+}
+
+TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed,
+                     const std::vector<SeamCandidate::Tack>& tacks) {
   // The tangent's sign from the chord between the roots kSignReach before and after: the
   // neighbouring roots, 1.5 mm apart, can lie crosswise at a corner, where the two legs meet
   // where their lines do, and turned a section's tangent against the travel.
@@ -118,6 +128,7 @@ TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
     path.B.push_back(secs[k].bisector);
     path.N.push_back(secs[k].normal);
     path.D.push_back(secs[k].depth);
+    path.W.push_back(on_tack(secs[k], tacks) ? 0.0 : 1.0);
     const std::size_t next = root_at_reach(secs, k, +1, closed, kSignReach);
     const std::size_t prev = root_at_reach(secs, k, -1, closed, kSignReach);
     Eigen::Vector3d t = secs[k].tangent;
@@ -130,6 +141,7 @@ TorchPath torch_path(const std::vector<GrooveSection>& secs, bool closed) {
     path.T.push_back(path.T.front());
     path.N.push_back(path.N.front());
     path.D.push_back(path.D.front());
+    path.W.push_back(path.W.front());
   }
   path.S.assign(path.P.size(), 0.0);
   for (std::size_t k = 1; k < path.P.size(); ++k) {
@@ -216,7 +228,7 @@ double mean_depth(const TorchPath& path, std::size_t k, double half, bool closed
   const double h = centred_half(path, k, half, closed);
   double sw = 0, sd = 0;
   for (std::size_t j = 0; j < n; ++j) {
-    const double w = tricube_weight(arc_offset(path, k, j, closed), h);
+    const double w = path.W[j] * tricube_weight(arc_offset(path, k, j, closed), h);
     sw += w;
     sd += w * path.D[j];
   }
@@ -235,8 +247,10 @@ double mean_depth(const TorchPath& path, std::size_t k, double half, bool closed
 // 40-60 mm waves; 0.89 mm now). A corner joint (fillet, lap) is taken alike: its depth is
 // the weld's throat, from the root to the line through its leg ends on the two faces, and
 // those faces are fitted as widely as a groove's top (the sweep's lap s310: 0.65 -> 0.53 mm
-// depth error). Only the path moves: the sections (and with them the region and the reported
-// stations) keep their roots.
+// depth error). Stations on a tack weld weigh nothing (TorchPath::W): their roots and depths
+// are their neighbours' interpolated, from the tack's flanks, and their tops stood up to
+// 1.8 mm high (the sweep's tacks s352). Only the path moves: the sections (and with them the
+// region and the reported stations) keep their roots.
 constexpr double kDepthWindow = 3.0;
 
 void smooth_depth(TorchPath& path, double half, bool closed) {
@@ -249,7 +263,7 @@ void smooth_depth(TorchPath& path, double half, bool closed) {
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (std::size_t j = 0; j < n; ++j) {
       const double d = arc_offset(path, k, j, closed);
-      const double w = tricube_weight(d, h);
+      const double w = path.W[j] * tricube_weight(d, h);
       if (w <= 0) continue;
       const Eigen::Vector3d x(1, d, d * d);
       A += w * x * x.transpose();
@@ -311,7 +325,7 @@ Trajectory seam_trajectory(const SeamCandidate& seam, const RobustParams& params
     orient_open(secs);
   }
   drop_folds(secs, closed);
-  TorchPath path = torch_path(secs, closed);
+  TorchPath path = torch_path(secs, closed, seam.tacks);
   smooth_depth(path, params.depth_smooth, closed);
   blend_orientation(path, params.orientation_blend, closed);
   const std::vector<Eigen::Vector3d>& P = path.P;
