@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <groovetrace/error.hpp>
+#include <groovetrace/eval.hpp>
 #include <groovetrace/robust.hpp>
 #include <groovetrace/synth.hpp>
 #include <optional>
@@ -217,6 +218,14 @@ SynthParams vga_joint(std::uint64_t seed) {
   return sp;
 }
 
+// The same at 1280x720.
+SynthParams hd_joint(std::uint64_t seed) {
+  SynthParams sp = vga_joint(seed);
+  sp.width = 1280;
+  sp.height = 720;
+  return sp;
+}
+
 // The sweep's v6-50 scene s316: a 6 mm, 50 deg V at 0.45 m, 640x480, 5 deg off square.
 SynthParams v6_50_s316() {
   SynthParams sp = vga_joint(316);
@@ -336,34 +345,13 @@ TEST(RobustDetect, GrooveEndingInsideThePlateStopsAtItsEnd) {
   EXPECT_LT(last, 0.003);
 }
 
-// The share (%) of the true seam's in-view root line (sampled every 0.5 mm) within 6 mm of a
-// waypoint of `t`, as `groovetrace eval` counts coverage.
-double coverage(const Trajectory& t, const Seam& truth) {
-  int seen = 0, covered = 0;
-  for (std::size_t k = 0; k + 1 < truth.root.size(); ++k) {
-    if (!truth.in_view[k] || !truth.in_view[k + 1]) continue;
-    const Eigen::Vector3d a = truth.root[k], ab = truth.root[k + 1] - a;
-    const int n = std::max(1, static_cast<int>(std::ceil(ab.norm() / 0.0005)));
-    for (int j = 0; j < n; ++j) {
-      const Eigen::Vector3d p = a + ab * (static_cast<double>(j) / n);
-      ++seen;
-      covered += std::any_of(t.waypoints.begin(), t.waypoints.end(),
-                             [&](const Waypoint& w) { return (w.position - p).norm() <= 0.006; });
-    }
-  }
-  return seen ? 100.0 * covered / seen : 0.0;
-}
-
 // The sweep's v60-160 s330: a wide panel joint (60 mm, 160 deg) at 0.45 m, 1280x720, 25 deg
 // tilt. Short of one end the first pass's tracking met two failed V fits in a row and
 // stopped, though the groove goes on: coverage 97.96 %, the waypoints 1.10 mm from the root
 // line on average. Tracking now crosses up to 20 mm of misses where three fits in a row on
 // the tracked line follow (robust/trace.cpp, kBridge): 100 %, 0.80 mm.
 TEST(RobustDetect, TrackingCrossesAGapWhereTheGrooveResumes) {
-  SynthParams sp;
-  sp.width = 1280;
-  sp.height = 720;
-  sp.seed = 330;
+  SynthParams sp = hd_joint(330);
   sp.groove_width = 0.06;
   sp.groove_angle_deg = 160;
   sp.distance = 0.45;
@@ -371,8 +359,7 @@ TEST(RobustDetect, TrackingCrossesAGapWhereTheGrooveResumes) {
   const JointRun run(sp);
   ASSERT_GE(accepted_count(run.det), 1u);
   const Trajectory t = seam_trajectory(*best_accepted(run.det), RobustParams{});
-  const Seam& truth = run.scan.truth.seams.at(0);
-  EXPECT_GT(coverage(t, truth), 99.5);
+  EXPECT_GT(evaluate(run.scan.truth, run.det.groove, tool_poses(t)).coverage_percent, 99.5);
   EXPECT_LT(run.errors(*best_accepted(run.det)).first, 0.0010);
 }
 
@@ -592,10 +579,7 @@ TEST(RobustDetect, NarrowGrooveIsKeptAtTheScaleThatReadsItWhole) {
 // apart, more than 3 links of that scale, and the longer, 190 mm, was the path (robust/
 // merge.cpp, bridge).
 TEST(RobustDetect, SmallGrooveStretchesAreJoinedAcrossTheirGap) {
-  SynthParams sp;
-  sp.width = 1280;
-  sp.height = 720;
-  sp.seed = 315;
+  SynthParams sp = hd_joint(315);
   sp.groove_width = 0.004;
   sp.groove_angle_deg = 60;
   sp.distance = 0.55;
