@@ -16,6 +16,12 @@ window's side samples in the slot dropped, as synth does). Prints the median wid
 against the truth, and each candidate's summed robust cost: without the gap the lowest picks
 the window the profiles were taken with; with it the costs tie, so the window's width has to
 come from the pixel geometry. Needs numpy and scipy (Debian's python3-scipy).
+
+Other grooves and sensors: --width, --angle, --pitch, --sigma, --window, --rows, and
+--depth-step (the D415's 1 mm depth unit: heights rounded to it at a random phase per profile).
+--ray-zones leaves out the points whose ray (here vertical: their u) passes within the zone of
+a vertex, instead of those whose measured position lies within it: noise then no longer decides
+which points near a rim are kept. --no-models prints the fit as today only.
 """
 import argparse
 
@@ -23,8 +29,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 HALF_WIDTH, PITCH, SIGMA, WINDOW = 3.0, 0.91, 0.6, 11.0  # mm
-GAP, TABLE, JUMP = 0.5, -16.43, 5.0  # mm: root gap, the table seen through it, a depth jump
+GAP, JUMP = 0.5, 5.0  # mm: root gap, a depth jump
 APEX = -HALF_WIDTH / np.tan(np.radians(25.0))
+TABLE = APEX - 10.0  # mm: the table seen through the gap
+ROWS, DEPTH_STEP, RAY_ZONES = 3, 0.0, False
 TUKEY = 4.685
 
 
@@ -64,7 +72,7 @@ def v_profile(x, u, blur=0.0, gap=0.0):
     return total / weight
 
 
-def scan_profile(rng, blur, noise, gap, rows=3):
+def scan_profile(rng, blur, noise, gap):
     """Points (u, v) of one profile as the renderer would measure them; with `gap`, rays
     between the root faces meet the table below."""
     u = np.arange(-WINDOW - 2 * PITCH, WINDOW + 2 * PITCH, PITCH) + rng.uniform(0, PITCH)
@@ -73,9 +81,13 @@ def scan_profile(rng, blur, noise, gap, rows=3):
         v = np.where(np.abs(u) < GAP / 2, TABLE, v)
     if blur:
         v = window(v, jump=JUMP)
+    rows = ROWS
     white = rng.normal(size=(rows, u.size))
     correlated = window(window(white, 0), 1) / (0.25**2 + 0.5**2 + 0.25**2)
     heights = v + SIGMA * correlated * (1.0 if noise else 0.0)
+    if DEPTH_STEP > 0:
+        phase = rng.uniform(0, DEPTH_STEP)
+        heights = np.round((heights + phase) / DEPTH_STEP) * DEPTH_STEP - phase
     keep = np.abs(u) <= WINDOW
     return np.tile(u[keep], rows), heights[:, keep].ravel()
 
@@ -88,7 +100,9 @@ def fit(u, v, blur, zone, gap=0.0, rounds=6):
     c = TUKEY * SIGMA
     for _ in range(rounds):
         corners = np.array([[x[0], x[1]], [x[2], x[4]], [x[3], x[4]]])
-        far = np.min(np.hypot(u[:, None] - corners[:, 0], v[:, None] - corners[:, 1]), 1) > zone
+        du = u[:, None] - corners[:, 0]
+        dist = np.abs(du) if RAY_ZONES else np.hypot(du, v[:, None] - corners[:, 1])
+        far = np.min(dist, 1) > zone
         r = v - v_profile(x, u, blur, gap)
         w = np.sqrt(np.where(np.abs(r) < c, (1 - (r / c) ** 2) ** 2, 0.0) * far)
         x = least_squares(lambda y: w * (v - v_profile(y, u, blur, gap)), x).x
@@ -101,7 +115,21 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--profiles", type=int, default=80)
     ap.add_argument("--seed", type=int, default=5)
+    ap.add_argument("--width", type=float, default=6.0, help="top width (mm)")
+    ap.add_argument("--angle", type=float, default=50.0, help="included angle (deg)")
+    ap.add_argument("--pitch", type=float, default=0.91, help="pixel pitch on the part (mm)")
+    ap.add_argument("--sigma", type=float, default=0.6, help="depth noise (mm)")
+    ap.add_argument("--window", type=float, default=11.0, help="half window (mm)")
+    ap.add_argument("--rows", type=int, default=3, help="image rows per profile")
+    ap.add_argument("--depth-step", type=float, default=0.0, help="depth unit (mm; 0: none)")
+    ap.add_argument("--ray-zones", action="store_true", help="vertex zones along the rays")
+    ap.add_argument("--no-models", action="store_true", help="only the fit as today")
     args = ap.parse_args()
+    global HALF_WIDTH, PITCH, SIGMA, WINDOW, APEX, TABLE, ROWS, DEPTH_STEP, RAY_ZONES
+    HALF_WIDTH, PITCH, SIGMA, WINDOW = args.width / 2, args.pitch, args.sigma, args.window
+    APEX = -HALF_WIDTH / np.tan(np.radians(args.angle / 2))
+    TABLE = APEX - 10.0
+    ROWS, DEPTH_STEP, RAY_ZONES = args.rows, args.depth_step, args.ray_zones
     candidates = [0.0, 0.5 * PITCH, PITCH, 1.5 * PITCH]
     print(f"truth: width {2 * HALF_WIDTH:.2f} mm, apex {APEX:.2f} mm (below the top)")
     for blur, noise, gap in ((False, True, False), (True, False, False), (True, True, False),
@@ -116,7 +144,7 @@ def main():
               f"apex {np.median(today[:, 1]):6.2f} mm")
         # The window modelled instead of avoided: every point counts, the costs compare. With
         # a gap, also the model that knows it.
-        for g in (0.0, GAP) if gap else (0.0,):
+        for g in () if args.no_models else (0.0, GAP) if gap else (0.0,):
             for b in candidates:
                 f = np.array([fit(u, v, b, 0.0, g) for u, v in profiles])
                 print(f"  model gap {g:3.1f} blur {b:4.2f} mm: width {np.median(f[:, 0]):5.2f} mm, "
