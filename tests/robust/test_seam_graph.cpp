@@ -177,5 +177,40 @@ TEST(RobustSeamGraph, NoisyStretchesOfOneSeamContinueEachOther) {
   }
 }
 
+// Past a clamp standing on the groove, a stretch too short to stand alone (12 mm, under
+// min_length) is kept where it continues an accepted seam: in its line beyond an open end, of
+// its width and depth, within 10 scales. Roots scatter by 0.3 mm as at 640x480 and 0.35 m.
+TEST(RobustSeamGraph, AShortStretchBeyondAClampContinuesTheSeam) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> scatter(0.0, 0.0003);
+  auto stretch = [&](double from, double to, double y, double width, const char* reason) {
+    SeamCandidate s;
+    for (double x = from; x < to; x += 0.0015) {
+      GrooveSection g;
+      g.root = Eigen::Vector3d(x, y + scatter(rng), 0.35 + scatter(rng));
+      s.sections.push_back(g);
+    }
+    s.width = width;
+    s.depth = 0.008;
+    s.accepted = reason == nullptr;
+    s.reason = reason ? reason : "";
+    return s;
+  };
+  std::vector<SeamCandidate> seams;
+  seams.push_back(stretch(-0.15, 0.05, 0, 0.010, nullptr));         // the seam, to a clamp
+  seams.push_back(stretch(0.100, 0.112, 0, 0.009, kTooShort));      // beyond the clamp
+  seams.push_back(stretch(-0.212, -0.2, 0, 0.011, kTooShort));      // beyond the other end
+  seams.push_back(stretch(0.100, 0.112, 0.004, 0.010, kTooShort));  // 4 mm beside the line
+  seams.push_back(stretch(0.100, 0.112, 0, 0.016, kTooShort));      // a wider groove
+  seams.push_back(stretch(0.160, 0.172, 0, 0.010, kTooShort));      // 110 mm on: too far
+  seams.push_back(stretch(-0.05, -0.038, 0, 0.010, kTooShort));     // on the seam, not beyond
+  seams.push_back(stretch(0.100, 0.112, 0, 0.010, "width or opening varies along the seam"));
+  robust_detail::accept_continuations(seams, 0.010);
+  const bool expected[] = {true, true, true, false, false, false, false, false};
+  for (std::size_t k = 0; k < seams.size(); ++k) EXPECT_EQ(seams[k].accepted, expected[k]) << k;
+  EXPECT_TRUE(seams[1].reason.empty());
+  EXPECT_EQ(seams[3].reason, kTooShort);
+}
+
 }  // namespace
 }  // namespace groovetrace

@@ -83,6 +83,12 @@ std::vector<GrooveSection> smooth_sections(const std::vector<GrooveSection>& raw
 /// direction points at the other end within 30 deg), or infinity.
 double collinear_gap(const SeamCandidate& a, const SeamCandidate& b);
 
+/// Accepts the seams of one scale's search (at `scale`, m) rejected only for their length
+/// (kTooShort) that continue an accepted groove seam beyond one of its open ends, past a
+/// clamp standing on the groove: in its line, within 10 scales of the end, of its width and
+/// depth. They stay seams of their own.
+void accept_continuations(std::vector<SeamCandidate>& seams, double scale);
+
 /// Joins seams that are stretches of one (overlapping, touching or continuing each other
 /// across a gap of up to 3 `link`, m) and traces the joined ones again.
 void merge_seams(const Context& ctx, std::vector<SeamCandidate>& seams, double link);

@@ -158,6 +158,9 @@ void trace_scale(const Cloud& cloud, ScaleSearch& search) {
   for (SeamCandidate& seam : search.seams) {
     score_seam(seam, params);
     seam.scale = params.scale;
+  }
+  robust_detail::accept_continuations(search.seams, params.scale);
+  for (SeamCandidate& seam : search.seams) {
     if (seam.accepted) robust_detail::extend_to_groove_ends(ctx, seam);
   }
   search.summary.seams = search.seams.size();

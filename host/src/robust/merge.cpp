@@ -12,16 +12,16 @@ namespace groovetrace::robust_detail {
 namespace {
 
 // Outward unit direction of an open seam at its end `which` (0 first, 1 last): the main axis
-// of the roots within 20 mm of it, pointing from their centroid to the end. Not the chord to
+// of the roots within `run` (m) of it, pointing from their centroid to the end. Not the chord to
 // the root 10 mm in: at 640x480 and 0.55 m single roots scatter by 1-2 mm, which turned that
 // chord 33 deg off a straight seam and kept two stretches of one groove apart at a clamp.
-Eigen::Vector3d end_direction(const SeamCandidate& s, int which) {
+Eigen::Vector3d end_direction(const SeamCandidate& s, int which, double run = 0.02) {
   const auto& secs = s.sections;
   const Eigen::Vector3d end = which == 0 ? secs.front().root : secs.back().root;
   std::vector<Eigen::Vector3d> near;
   for (std::size_t q = 0; q < secs.size(); ++q) {
     const auto& r = secs[which == 0 ? q : secs.size() - 1 - q].root;
-    if ((r - end).norm() > 0.02) break;
+    if ((r - end).norm() > run) break;
     near.push_back(r);
   }
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -36,6 +36,61 @@ Eigen::Vector3d end_direction(const SeamCandidate& s, int which) {
 }
 
 }  // namespace
+
+// A groove stretch too short to stand alone (under min_length) continues an accepted groove
+// seam beyond something standing on the groove: a clamp across it hides 30-50 mm, and the
+// 12-19 mm beyond it, up to the plate's edge, were dropped (the sweep's clamps-bar s360). It
+// is taken where it lies beyond one of the seam's open ends, within kReachPerScale search
+// scales, every root within kOffLine of the seam's line there (across and in depth), its width and
+// depth within kLike of the seam's. It stays a seam of its own: the path does not run through the
+// clamp.
+constexpr double kReachPerScale = 10.0;
+constexpr double kOffLine = 0.002;
+constexpr double kLike = 0.3;
+// The seam's line at an end: its main axis over this much of it (m), longer than a join's
+// (end_direction): extrapolated 50-60 mm past a clamp, the axis over 20 mm was 2-4 mm off.
+constexpr double kEndRun = 0.05;
+
+namespace {
+
+// Whether every root of `c` lies beyond end `which` of `seam` (0 first, 1 last), in its line
+// and within `reach` (m).
+bool lies_beyond(const SeamCandidate& c, const SeamCandidate& seam, int which, double reach) {
+  const Eigen::Vector3d out = end_direction(seam, which, kEndRun);
+  if (out.isZero()) return false;
+  const Eigen::Vector3d end = which == 0 ? seam.sections.front().root : seam.sections.back().root;
+  for (const GrooveSection& s : c.sections) {
+    const Eigen::Vector3d d = s.root - end;
+    const double along = d.dot(out);
+    if (!(along > 0 && along <= reach) || (d - along * out).norm() > kOffLine) return false;
+  }
+  return true;
+}
+
+bool alike(double a, double b) { return std::abs(a - b) <= kLike * b; }
+
+}  // namespace
+
+void accept_continuations(std::vector<SeamCandidate>& seams, double scale) {
+  // Only seams accepted on their own carry a continuation on: no chains of short stretches.
+  std::vector<bool> parent;
+  for (const SeamCandidate& s : seams) parent.push_back(s.accepted);
+  for (SeamCandidate& c : seams) {
+    if (c.reason != kTooShort || c.corner || c.sections.empty()) continue;
+    for (std::size_t k = 0; k < seams.size(); ++k) {
+      const SeamCandidate& seam = seams[k];
+      if (!parent[k] || seam.corner || seam.closed || seam.sections.size() < 2 ||
+          !alike(c.width, seam.width) || !alike(c.depth, seam.depth))
+        continue;
+      if (lies_beyond(c, seam, 0, kReachPerScale * scale) ||
+          lies_beyond(c, seam, 1, kReachPerScale * scale)) {
+        c.accepted = true;
+        c.reason.clear();
+        break;
+      }
+    }
+  }
+}
 
 double collinear_gap(const SeamCandidate& a, const SeamCandidate& b) {
   if (a.closed || b.closed || a.sections.size() < 2 || b.sections.size() < 2) return INFINITY;

@@ -107,13 +107,11 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
   seam.joint = joint_kind(seam);
   seam.misalignment = median_misalignment(seam.sections);
 
+  // The length is judged last: "shorter than min_length" is a groove in every other respect
+  // (accept_continuations).
   seam.accepted = false;
   if (width.size() < 3) {
     seam.reason = "fewer than 3 V-shaped sections";
-  } else if (seam.length < params.min_length) {
-    seam.reason = "shorter than min_length";
-  } else if (seam.corner && seam.length < kMinCornerLength) {
-    seam.reason = "a corner shorter than a fixture's (clamp, block)";
   } else if (seam.ok_fraction < 0.4) {
     seam.reason = "fewer than 40 % of the sections are V-shaped";
   } else if (seam.consistency < 0.35) {
@@ -122,6 +120,10 @@ void score_seam(SeamCandidate& seam, const RobustParams& params) {
     seam.reason = "implausible opening angle";
   } else if (floored > kMaxFloored * width.size()) {
     seam.reason = "a channel with a floor between its walls, not a joint";
+  } else if (seam.length < params.min_length) {
+    seam.reason = kTooShort;
+  } else if (seam.corner && seam.length < kMinCornerLength) {
+    seam.reason = "a corner shorter than a fixture's (clamp, block)";
   } else {
     seam.accepted = true;
     seam.reason.clear();

@@ -211,6 +211,9 @@ int bevel_square_side(const std::vector<GrooveSection>& sections);
 /// reason and the medians).
 void score_seam(SeamCandidate& seam, const RobustParams& params);
 
+/// score_seam's reason for a seam that is a groove in every respect but its length.
+inline constexpr const char* kTooShort = "shorter than min_length";
+
 /// Labels groove points: a point is groove when its viewing ray (from cloud.viewpoint) passes
 /// through the opening of an accepted seam (between the two fitted top edges of the nearest
 /// sections) and the point lies at or below that opening. Returns 1/0 per point.
