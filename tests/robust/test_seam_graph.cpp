@@ -209,7 +209,24 @@ TEST(RobustSeamGraph, AShortStretchBeyondAClampContinuesTheSeam) {
   const bool expected[] = {true, true, true, false, false, false, false, false};
   for (std::size_t k = 0; k < seams.size(); ++k) EXPECT_EQ(seams[k].accepted, expected[k]) << k;
   EXPECT_TRUE(seams[1].reason.empty());
+  EXPECT_EQ(seams[1].continues, 0);
+  EXPECT_EQ(seams[0].continues, -1);
   EXPECT_EQ(seams[3].reason, kTooShort);
+}
+
+// A continuation is exported with the seam it continues and does not count against
+// max_seams; one whose seam is not exported is not either.
+TEST(RobustSeamGraph, AContinuationIsExportedWithItsSeam) {
+  std::vector<SeamCandidate> seams(5);
+  for (int k = 0; k < 5; ++k) {
+    seams[k].id = 10 + k;
+    seams[k].accepted = k < 4;
+  }
+  seams[2].continues = 10;  // of the best seam
+  seams[3].continues = 11;  // of the second
+  const std::vector<bool> one = exported_seams(seams, 1), two = exported_seams(seams, 2);
+  EXPECT_EQ(one, std::vector<bool>({true, false, true, false, false}));
+  EXPECT_EQ(two, std::vector<bool>({true, true, true, true, false}));
 }
 
 }  // namespace

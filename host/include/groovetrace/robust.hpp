@@ -111,6 +111,10 @@ struct SeamCandidate {
   bool accepted = false;
   std::string reason;   ///< why rejected (empty when accepted)
   bool corner = false;  ///< traced as a corner joint (fillet, lap), not a groove (V, bevel)
+  int id = -1;          ///< this candidate's number within its RobustDetection
+  /// A stretch shorter than min_length accepted as the continuation of the seam numbered this
+  /// past a clamp (docs/method-robust.md, "Beyond a clamp"); -1 on a seam accepted on its own.
+  int continues = -1;
 };
 
 /// Torch poses along a seam: positions on the smoothed root line (its height along the top
@@ -165,5 +169,10 @@ GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& par
                                      const std::function<void(const std::string&)>& lap = {});
 GT_API RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
                                      const std::function<void(const std::string&)>& lap = {});
+
+/// Which of `seams` (best first) are exported as trajectories: the first `max_seams` accepted
+/// on their own, and the accepted continuations of those (SeamCandidate::continues), which do
+/// not count against `max_seams`. One flag per seam, in their order.
+GT_API std::vector<bool> exported_seams(const std::vector<SeamCandidate>& seams, int max_seams);
 
 }  // namespace groovetrace

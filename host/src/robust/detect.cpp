@@ -274,7 +274,12 @@ RobustDetection trace_searches(const Cloud& cloud, std::vector<ScaleSearch>& sea
       det.confirmed_nodes = search.summary.confirmed_nodes;
     }
     det.scales.push_back(search.summary);
-    for (SeamCandidate& seam : search.seams) all.push_back(std::move(seam));
+    const int first = static_cast<int>(all.size());
+    for (SeamCandidate& seam : search.seams) {
+      seam.id = static_cast<int>(all.size());
+      if (seam.continues >= 0) seam.continues += first;
+      all.push_back(std::move(seam));
+    }
   }
   robust_detail::reject_corners_on_table(searches.back().map, all);
   det.seams = one_scale_per_groove(std::move(all));
@@ -313,6 +318,23 @@ RobustDetection detect_robust(const Cloud& cloud, const RobustParams& params,
   det.groove = label_grooves(cloud, det.seams);
   if (lap) lap("region");
   return det;
+}
+
+std::vector<bool> exported_seams(const std::vector<SeamCandidate>& seams, int max_seams) {
+  std::vector<bool> out(seams.size(), false);
+  std::vector<int> ids;
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    if (!seams[k].accepted || seams[k].continues >= 0) continue;
+    if (static_cast<int>(ids.size()) >= max_seams) break;
+    out[k] = true;
+    ids.push_back(seams[k].id);
+  }
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    const SeamCandidate& s = seams[k];
+    out[k] = out[k] || (s.accepted && s.continues >= 0 &&
+                        std::find(ids.begin(), ids.end(), s.continues) != ids.end());
+  }
+  return out;
 }
 
 }  // namespace groovetrace

@@ -86,6 +86,7 @@ void accept_continuations(std::vector<SeamCandidate>& seams, double scale) {
           lies_beyond(c, seam, 1, kReachPerScale * scale)) {
         c.accepted = true;
         c.reason.clear();
+        c.continues = static_cast<int>(k);  // its index here; detect.cpp numbers them all
         break;
       }
     }

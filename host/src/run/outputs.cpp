@@ -111,12 +111,13 @@ json seam_json(const SeamCandidate& s, std::size_t rank, const json& file, const
 json robust_report(const RobustDetection& rd, const std::vector<Trajectory>& trajectories,
                    int max_seams) {
   json seams = json::array();
+  const std::vector<bool> written = exported_seams(rd.seams, max_seams);
   int exported = 0;
   for (std::size_t k = 0; k < rd.seams.size(); ++k) {
     const SeamCandidate& s = rd.seams[k];
     json file = nullptr;
     const Trajectory* t = nullptr;
-    if (s.accepted && exported < max_seams) {
+    if (written[k]) {
       file = exported == 0 ? "trajectory.csv" : "trajectory_" + std::to_string(exported) + ".csv";
       const auto e = static_cast<std::size_t>(exported);
       t = e < trajectories.size() ? &trajectories[e] : nullptr;

@@ -66,10 +66,11 @@ void run_robust(const Cloud& cloud, const Params& params, FeatureBackend& backen
   r.score.resize(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) r.score[i] = r.robust.concavity[i] * 1000.0f;
   r.score_unit = "mm";
-  for (const SeamCandidate& s : r.robust.seams) {
-    if (!s.accepted) continue;
-    ++r.seams_found;
-    if (static_cast<int>(r.trajectories.size()) >= rp.max_seams) continue;
+  const std::vector<bool> exported = exported_seams(r.robust.seams, rp.max_seams);
+  for (std::size_t k = 0; k < r.robust.seams.size(); ++k) {
+    const SeamCandidate& s = r.robust.seams[k];
+    r.seams_found += s.accepted;
+    if (!exported[k]) continue;
     r.trajectories.push_back(seam_trajectory(s, rp));
     // The fitted sections are only read by multi-pass planning and the weave's bound.
     const bool sections = params.weld.multi_pass || params.weld.weave != "none";
