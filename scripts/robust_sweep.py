@@ -771,7 +771,10 @@ def joint_run(binary, out_root, spec):
     rec["method"], rec["variant"] = "robust", "joints"
     if rec["rc"] == 0:
         rec["metrics"] = evaluate(binary, scan, out)
-        rec["problems"] = check_trajectory(os.path.join(out, "trajectory.csv"))[0]
+        csvs = trajectory_csvs(out)  # a seam's stretch past a clamp is exported beside it
+        rec["problems"] = [p for c in csvs for p in check_trajectory(c)[0]]
+        if len(csvs) > 1:
+            rec["coverage_union"] = union_coverage(scan[:-4] + ".truth.json", csvs)
         rec["scale_m"] = seam_report(out).get("scale_m")
     with open(scan[:-4] + ".truth.json") as f:
         truth = json.load(f)
@@ -915,9 +918,11 @@ def scan_values(r):
     found = r["rc"] == 0 and bool(m)
     mm = lambda k: m.get(k) * 1e3 if found and m.get(k) is not None else float("nan")
     num = lambda k, miss: (m.get(k) if m.get(k) is not None else float("nan")) if found else miss
+    coverage = r["coverage_union"] if found and "coverage_union" in r else \
+        num("coverage_percent", 0.0)
     return {"found": found, "iou": num("iou_percent", 0.0), "lateral_mm": mm("lateral_mean_m"),
             "depth_mm": mm("depth_mean_m"), "tool_deg": num("tool_axis_mean_deg", float("nan")),
-            "coverage": num("coverage_percent", 0.0), "joint_found": m.get("joint_found"),
+            "coverage": coverage, "joint_found": m.get("joint_found"),
             "joint_match": m.get("joint_match") if found else None}
 
 
@@ -1083,6 +1088,8 @@ def joint_header(args, records):
         "target when its mean over its scans meets it; k/n = scans meeting it on their own. A "
         "scan that exits 4 (no groove found) although it has a joint counts as found = no, IoU "
         "0 % and coverage 0 %; its lateral, depth and tool axis are left out (no trajectory). "
+        "Where a stretch past a clamp is exported beside the seam (trajectory_1.csv), coverage "
+        "is over the union of both trajectories. "
         "found = exit 0: the exported seam may still be another one than the joint (IoU near 0, "
         "errors of centimetres: see every scan). "
         "The detector reports `V`, `bevel`, `fillet` or `lap` per seam.", ""]
